@@ -1,0 +1,138 @@
+"""Grid update: nodal momentum to velocity, gravity, walls (MODEL.md 5).
+
+Walls are planes ``(point, normal)`` with the normal pointing into the
+material. A node with signed distance ``phi = (x_i - p(t)) . n <= 0`` lies in
+the wall and its velocity relative to the wall is constrained:
+
+- ``STICKY``: relative velocity set to zero;
+- ``SLIP``: normal component removed, tangential kept (frictionless, bonded);
+- ``SEPARATE``: only an approaching normal component is removed, and Coulomb
+  friction ``mu`` acts on the tangential part (sticks while
+  ``|v_t| <= -mu v_n``).
+
+The impulse each wall gives the material is accumulated per wall, so the mean
+reaction force over a frame is ``impulse / frame duration``. The wall code is
+compiled only into scenes that have walls.
+"""
+
+import functools
+
+import warp as wp
+
+from .types import vec3
+
+STICKY = 0
+SLIP = 1
+SEPARATE = 2
+
+
+@functools.cache
+def wall_struct(T):
+    """Kernel-side wall description for scalar type ``T``.
+
+    Fields: ``point`` (m) at t = 0, ``normal`` (unit, into the material),
+    ``velocity`` (m/s) reached after ``ramp_time`` (s, linear ramp from rest;
+    0 means constant from the start), ``kind`` (0 sticky, 1 slip, 2 separate),
+    ``friction`` (Coulomb coefficient, -).
+    """
+    V = vec3(T)
+
+    @wp.struct
+    class WallParams:
+        point: V
+        normal: V
+        velocity: V
+        ramp_time: T
+        kind: wp.int32
+        friction: T
+
+    return WallParams
+
+
+@functools.cache
+def wall_motion_func(T):
+    """Return ``motion(wall, t) -> (point(t), velocity(t))`` evaluated on the device."""
+    WallParams = wall_struct(T)
+
+    @wp.func
+    def motion(w: WallParams, t: T):
+        vel = w.velocity
+        disp = w.velocity * t
+        if w.ramp_time > T(0.0):
+            if t < w.ramp_time:
+                vel = w.velocity * (t / w.ramp_time)
+                disp = w.velocity * (T(0.5) * t * t / w.ramp_time)
+            else:
+                disp = w.velocity * (t - T(0.5) * w.ramp_time)
+        return w.point + disp, vel
+
+    return motion
+
+
+@functools.cache
+def grid_update_kernel(T, has_walls: bool):
+    """Build the grid update kernel (launched over all nodes).
+
+    ``grid_p`` holds nodal momentum (kg m/s) on entry and velocity (m/s) on
+    exit. ``vmax[0]`` receives the largest nodal speed (m/s), used by the
+    automatic time step of the next step.
+    """
+    V = vec3(T)
+    WallParams = wall_struct(T)
+    motion = wall_motion_func(T)
+
+    @wp.kernel(enable_backward=False)
+    def grid_update(
+        grid_m: wp.array3d(dtype=T),
+        grid_p: wp.array3d(dtype=V),
+        dt_arr: wp.array(dtype=T),
+        clock: wp.array(dtype=wp.float64),
+        gravity: V,
+        gravity_ramp: T,
+        mass_threshold: T,
+        origin: V,
+        dx: T,
+        walls: wp.array(dtype=WallParams),
+        wall_impulse: wp.array(dtype=V),
+        vmax: wp.array(dtype=T),
+    ):
+        i, j, k = wp.tid()
+        dt = dt_arr[0]
+        if dt <= T(0.0):
+            return
+        m = grid_m[i, j, k]
+        if m <= mass_threshold:
+            grid_p[i, j, k] = V(T(0.0), T(0.0), T(0.0))
+            return
+        t = T(clock[0])
+        g_scale = T(1.0)
+        if gravity_ramp > T(0.0):
+            g_scale = wp.min(t / gravity_ramp, T(1.0))
+        vel = grid_p[i, j, k] / m + (dt * g_scale) * gravity
+        if wp.static(has_walls):
+            xn = origin + V(T(i), T(j), T(k)) * dx
+            for w in range(walls.shape[0]):
+                wall = walls[w]
+                pw, vw = motion(wall, t + dt)
+                n = wall.normal
+                if wp.dot(xn - pw, n) <= T(0.0):
+                    v_old = vel
+                    vrel = vel - vw
+                    vn = wp.dot(vrel, n)
+                    if wall.kind == 0:
+                        vrel = V(T(0.0), T(0.0), T(0.0))
+                    elif wall.kind == 1:
+                        vrel = vrel - vn * n
+                    elif vn < T(0.0):
+                        vt = vrel - vn * n
+                        vt_norm = wp.length(vt)
+                        if vt_norm <= -wall.friction * vn:
+                            vrel = V(T(0.0), T(0.0), T(0.0))
+                        else:
+                            vrel = vt * (T(1.0) + wall.friction * vn / vt_norm)
+                    vel = vw + vrel
+                    wp.atomic_add(wall_impulse, w, m * (v_old - vel))
+        grid_p[i, j, k] = vel
+        wp.atomic_max(vmax, 0, wp.length(vel))
+
+    return grid_update

@@ -1,0 +1,109 @@
+"""Particle-to-grid transfer (MLS-MPM, Hu et al. 2018) with the constitutive update.
+
+One launch per particle group (a block of one material). Per particle, in
+physical order:
+
+1. trial elastic deformation gradient ``F_tr = (I + dt C) F_E`` (MODEL.md 4);
+2. SVD ``F_tr = U diag(s) V^T`` (one SVD per particle and step);
+3. plasticity (Cam-Clay return, compiled in only for plastic groups) or the
+   singular-value floor for elastic groups;
+4. Kirchhoff stress ``tau = U diag(2 mu eps + lam tr eps) U^T``, ``eps = ln s``;
+5. scatter of mass and of the MLS-MPM momentum
+   ``m v + (m C - dt V0 D^-1 tau) (x_i - x_p)``, ``D^-1 = 4 / dx^2``.
+"""
+
+import functools
+
+import warp as wp
+
+from .camclay import camclay_return_func
+from .elasticity import clamp_singular_func, hencky_func
+from .shape import stencil_func
+from .types import mat33, vec3
+
+
+@functools.cache
+def p2g_kernel(T, plastic: bool, track_yield: bool):
+    """Build the P2G kernel.
+
+    Parameters
+    ----------
+    T : warp scalar type
+        ``wp.float32`` or ``wp.float64``.
+    plastic : bool
+        Compile the Cam-Clay return (``log_jp`` is read and written).
+    track_yield : bool
+        Also set ``yielded[i] = 1`` where the return was active (output field).
+    """
+    V = vec3(T)
+    M = mat33(T)
+    stencil = stencil_func(T)
+    hencky = hencky_func(T)
+    clamp_sv = clamp_singular_func(T)
+    camclay = camclay_return_func(T)
+
+    @wp.kernel(enable_backward=False)
+    def p2g(
+        x: wp.array(dtype=V),
+        v: wp.array(dtype=V),
+        C: wp.array(dtype=M),
+        F: wp.array(dtype=M),
+        log_jp: wp.array(dtype=T),
+        yielded: wp.array(dtype=wp.uint8),
+        mass: T,
+        vol0: T,
+        mu: T,
+        lam: T,
+        M_csl: T,
+        beta: T,
+        xi: T,
+        p0_floor: T,
+        s_floor: T,
+        dt_arr: wp.array(dtype=T),
+        origin: V,
+        inv_dx: T,
+        dx: T,
+        grid_m: wp.array3d(dtype=T),
+        grid_p: wp.array3d(dtype=V),
+    ):
+        i = wp.tid()
+        dt = dt_arr[0]
+        if dt <= T(0.0):
+            return
+        xp = x[i]
+        Cp = C[i]
+        F_tr = (wp.identity(3, dtype=T) + dt * Cp) * F[i]
+        U = M()
+        s = V()
+        Vt = M()
+        wp.svd3(F_tr, U, s, Vt)
+        s_new = clamp_sv(s, s_floor)
+        changed = 0
+        if s_new[2] != s[2]:
+            changed = 1
+        if wp.static(plastic):
+            s_ret, ljp, y = camclay(s_new, log_jp[i], mu, lam, M_csl, beta, xi, p0_floor)
+            s_new = s_ret
+            log_jp[i] = ljp
+            changed = changed | int(y)
+            if wp.static(track_yield):
+                if y != 0:
+                    yielded[i] = wp.uint8(1)
+        if changed != 0:
+            F[i] = U * wp.diag(s_new) * wp.transpose(Vt)
+        else:
+            F[i] = F_tr
+        tau_p = hencky(s_new, mu, lam, s_floor)
+        tau = U * wp.diag(tau_p) * wp.transpose(U)
+        A = (-dt * vol0 * T(4.0) * inv_dx * inv_dx) * tau + mass * Cp
+        mv = mass * v[i]
+        b, fx, W = stencil(xp, origin, inv_dx)
+        for a in range(3):
+            for c in range(3):
+                for d in range(3):
+                    w = W[a, 0] * W[c, 1] * W[d, 2]
+                    dpos = (V(T(a), T(c), T(d)) - fx) * dx
+                    wp.atomic_add(grid_m, b[0] + a, b[1] + c, b[2] + d, w * mass)
+                    wp.atomic_add(grid_p, b[0] + a, b[1] + c, b[2] + d, w * (mv + A * dpos))
+
+    return p2g

@@ -1,0 +1,149 @@
+"""Constitutive models: elastic snow/ice and cohesive Cam-Clay snow (MODEL.md 1-3).
+
+Materials are plain dataclasses; the engine turns them into kernel arguments.
+Every model uses St Venant-Kirchhoff elasticity in Hencky strain.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+from .validate import finite_number
+
+__all__ = ["Elastic", "CamClaySnow", "Material", "material_from_dict", "MATERIAL_MODELS"]
+
+
+@dataclass(frozen=True)
+class Elastic:
+    """Hencky St Venant-Kirchhoff elastic solid.
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus (Pa), > 0.
+    nu : float
+        Poisson's ratio (-), in [0, 0.5).
+    density : float
+        Mass density (kg/m^3), > 0.
+    """
+
+    E: float
+    nu: float
+    density: float
+    model: str = field(default="elastic", init=False)
+    plastic = False
+
+    def validate(self, where: str = "material") -> Elastic:
+        """Check every parameter; raise InvalidArgument naming ``where.field``."""
+        finite_number(f"{where}.E", self.E, lo=0.0, lo_open=True)
+        finite_number(f"{where}.nu", self.nu, lo=0.0, hi=0.5, hi_open=True)
+        finite_number(f"{where}.density", self.density, lo=0.0, lo_open=True)
+        return self
+
+    @property
+    def mu(self) -> float:
+        """Shear modulus (Pa)."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def lam(self) -> float:
+        """First Lame parameter (Pa)."""
+        return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+
+    @property
+    def bulk(self) -> float:
+        """Bulk modulus K = lam + 2 mu / 3 (Pa)."""
+        return self.lam + 2.0 * self.mu / 3.0
+
+    @property
+    def p_wave_speed(self) -> float:
+        """c_p = sqrt((lam + 2 mu) / rho) (m/s)."""
+        return math.sqrt((self.lam + 2.0 * self.mu) / self.density)
+
+    @property
+    def s_wave_speed(self) -> float:
+        """c_s = sqrt(mu / rho) (m/s)."""
+        return math.sqrt(self.mu / self.density)
+
+    @property
+    def rayleigh_speed(self) -> float:
+        """Rayleigh wave speed c_R ~ c_s (0.862 + 1.14 nu) / (1 + nu) (m/s), MODEL.md 7."""
+        return self.s_wave_speed * (0.862 + 1.14 * self.nu) / (1.0 + self.nu)
+
+    def to_dict(self) -> dict:
+        """Plain dict (for scenario files and output attributes)."""
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class CamClaySnow(Elastic):
+    """Cohesive modified Cam-Clay snow with hardening and softening (MODEL.md 2-3).
+
+    Parameters
+    ----------
+    E, nu, density : float
+        Elasticity as in :class:`Elastic`.
+    M : float
+        Slope of the critical state line (-), > 0.
+    beta : float
+        Cohesion ratio (-): tensile strength is ``beta p0``; >= 0.
+    xi : float
+        Hardening factor (-) in ``p0 = K sinh(xi max(-log_Jp, 0))``; > 0.
+    p0_ini : float
+        Initial consolidation pressure (Pa), >= 0; sets ``log_Jp(0) = -asinh(p0_ini/K)/xi``.
+    p0_floor_ratio : float
+        Floor of p0 relative to K (-), keeps the return defined for fully
+        softened material; default 1e-5 (MODEL.md 3).
+    """
+
+    M: float = 1.0
+    beta: float = 0.3
+    xi: float = 1.0
+    p0_ini: float = 0.0
+    p0_floor_ratio: float = 1e-5
+    model: str = field(default="camclay", init=False)
+    plastic = True
+
+    def validate(self, where: str = "material") -> CamClaySnow:
+        """Check every parameter; raise InvalidArgument naming ``where.field``."""
+        super().validate(where)
+        finite_number(f"{where}.M", self.M, lo=0.0, lo_open=True)
+        finite_number(f"{where}.beta", self.beta, lo=0.0)
+        finite_number(f"{where}.xi", self.xi, lo=0.0, lo_open=True)
+        finite_number(f"{where}.p0_ini", self.p0_ini, lo=0.0)
+        finite_number(f"{where}.p0_floor_ratio", self.p0_floor_ratio, lo=0.0, hi=1e-2, lo_open=True)
+        return self
+
+    @property
+    def p0_floor(self) -> float:
+        """Floor of the consolidation pressure (Pa)."""
+        return self.p0_floor_ratio * self.bulk
+
+    @property
+    def initial_log_jp(self) -> float:
+        """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (MODEL.md 3)."""
+        return -math.asinh(self.p0_ini / self.bulk) / self.xi
+
+
+Material = Elastic | CamClaySnow
+MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow}
+
+
+def material_from_dict(d: dict, where: str = "material") -> Elastic:
+    """Build a material from a dict with a ``model`` key; unknown keys are errors."""
+    from .errors import ScenarioError
+
+    d = dict(d)
+    model = d.pop("model", "elastic")
+    if model not in MATERIAL_MODELS:
+        raise ScenarioError(f"{where}.model = {model!r} is unknown: expected one of {sorted(MATERIAL_MODELS)}")
+    cls = MATERIAL_MODELS[model]
+    names = [f for f in cls.__dataclass_fields__ if f != "model"]
+    for k in d:
+        if k not in names:
+            raise ScenarioError(f"{where}.{k}: unknown key for model {model!r}; allowed: {', '.join(names)}")
+    for k in ("E", "nu", "density"):
+        if k not in d:
+            raise ScenarioError(f"{where}.{k}: missing (required for model {model!r})")
+    return cls(**d).validate(where)

@@ -1,0 +1,368 @@
+"""Running a scenario: frames, output, health checks, checkpoints and resume.
+
+Data flows one way: scenario -> model/state -> stepper (kernels) -> output.
+The host touches the device only between batches of steps (clock and health
+flags, a few bytes) and at frames (output fields).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import platform
+import time as _time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import warp as wp
+
+from . import io
+from .device import resolve_device
+from .errors import InvalidArgument, SimulationBlowUp
+from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_invariants_kernel
+from .model import SINGULAR_VALUE_FLOOR, Model, State
+from .scenario import OUTPUT_FIELDS, Scenario
+from .step import Stepper
+
+__all__ = ["Simulation", "RunResult", "versions"]
+
+#: a particle may not move more than this many cells in one step (health check)
+MAX_CELLS_PER_STEP = 1.0
+
+
+def versions() -> dict[str, str]:
+    """Versions of the library and its main dependencies."""
+    import h5py
+
+    from . import __version__
+
+    return {"mpm_warp": __version__, "warp": wp.config.version, "numpy": np.__version__, "h5py": h5py.__version__,
+            "python": platform.python_version()}
+
+
+@dataclass
+class RunResult:
+    """What a run returns.
+
+    Attributes
+    ----------
+    output : str or None
+        Path of the HDF5 file.
+    steps : int
+        Steps taken in this call.
+    frames : int
+        Frames written in this call.
+    sim_time : float
+        Simulated time reached (s).
+    wall_time : float
+        Wall-clock time of the stepping (s), compilation excluded.
+    particle_steps_per_s : float
+        ``n_particles * steps / wall_time``.
+    n_particles : int
+    device : str
+    edge_hits : int
+        Particle clamps at the grid edge (see ``kernels/g2p.py``).
+    extra : dict
+        Scene diagnostics (crack speed, errors against references, ...).
+    """
+
+    output: str | None
+    steps: int
+    frames: int
+    sim_time: float
+    wall_time: float
+    particle_steps_per_s: float
+    n_particles: int
+    device: str
+    edge_hits: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+class Simulation:
+    """A scenario instantiated on a device.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Validated scenario (``Scenario.validate()`` is called again here).
+    device : str or None
+        ``"cpu"``, ``"cuda"``, ``"cuda:N"`` or None (``MPM_WARP_DEVICE``, then CUDA if present).
+    use_graph : bool or None
+        CUDA graph capture of step batches (default on CUDA).
+
+    Examples
+    --------
+    >>> sim = Simulation(load_scenario("elastic_block"))          # doctest: +SKIP
+    >>> result = sim.run("out.h5")                                # doctest: +SKIP
+    """
+
+    def __init__(self, scenario: Scenario, device: str | None = None, use_graph: bool | None = None):
+        self.scenario = scenario.validate()
+        self.device = resolve_device(device)
+        self.model = Model(self.scenario, self.device)
+        fields_ = self.scenario.output.fields
+        self.state: State = self.model.initial_state(track_yield="yielded" in fields_)
+        self.stepper = Stepper(self.model, self.state, use_graph)
+        self.frame_index = 0
+        self.x0 = self.state.x.numpy().astype(np.float64)
+        #: functions ``f(sim) -> dict[str, float]`` evaluated at every frame and stored as scalar series
+        self.frame_diagnostics: list[Callable[[Simulation], dict]] = []
+        #: objects with ``launch()`` run on the device before every step (e.g. a saw)
+        self.step_actions: list = []
+        self._bad = wp.full(3, INT_MAX, dtype=wp.int32, device=self.device)
+        self._energy = wp.zeros(2, dtype=wp.float64, device=self.device)
+
+    # ----------------------------------------------------------------- public
+    @property
+    def time(self) -> float:
+        """Simulated time (s)."""
+        return float(self.state.clock.numpy()[0])
+
+    def energies(self) -> dict[str, float]:
+        """Kinetic and elastic energy (J) of the current state."""
+        self._energy.zero_()
+        T = self.model.T
+        s = self.state
+        for g in self.model.groups:
+            sl = slice(g.start, g.end)
+            m = g.material
+            wp.launch(energy_kernel(T), g.count,
+                      inputs=[s.v[sl], s.F[sl], T(g.mass), T(g.vol0), T(m.mu), T(m.lam), T(SINGULAR_VALUE_FLOOR),
+                              self._energy], device=self.device)
+        e = self._energy.numpy()
+        return {"kinetic_energy": float(e[0]), "elastic_energy": float(e[1])}
+
+    def stress_invariants(self) -> tuple[np.ndarray, np.ndarray]:
+        """Pressure p and Mises stress q (Pa, Kirchhoff) of every particle."""
+        T = self.model.T
+        n = self.model.n_particles
+        p = wp.zeros(n, dtype=T, device=self.device)
+        q = wp.zeros(n, dtype=T, device=self.device)
+        for g in self.model.groups:
+            sl = slice(g.start, g.end)
+            m = g.material
+            wp.launch(stress_invariants_kernel(T), g.count,
+                      inputs=[self.state.F[sl], T(m.mu), T(m.lam), T(SINGULAR_VALUE_FLOOR), p[sl], q[sl]],
+                      device=self.device)
+        return p.numpy(), q.numpy()
+
+    def particle_field(self, name: str) -> np.ndarray:
+        """Host copy of one output field for all particles (see ``OUTPUT_FIELDS``)."""
+        s = self.state
+        n = self.model.n_particles
+        if name in ("x", "v", "F"):
+            return getattr(s, name).numpy()
+        if name == "log_jp":
+            out = np.zeros(n, dtype=self.model.np_dtype)
+            if s.log_jp is not None:
+                lj = s.log_jp.numpy()
+                for g in self.model.groups:
+                    if g.plastic_start >= 0:
+                        out[g.start:g.end] = lj[g.plastic_start:g.plastic_start + g.count]
+            return out
+        if name in ("p", "q"):
+            p, q = self.stress_invariants()
+            return p if name == "p" else q
+        if name == "yielded":
+            out = np.zeros(n, dtype=np.uint8)
+            if s.yielded is not None:
+                y = s.yielded.numpy()
+                for g in self.model.groups:
+                    if g.plastic_start >= 0:
+                        out[g.start:g.end] = y[g.plastic_start:g.plastic_start + g.count]
+                s.yielded.zero_()
+            return out
+        raise InvalidArgument("field", name, "one of " + ", ".join(OUTPUT_FIELDS))
+
+    def health(self) -> None:
+        """Run the device health check; raise SimulationBlowUp on failure."""
+        self._bad.fill_(INT_MAX)
+        s = self.state
+        T = self.model.T
+        wp.launch(health_kernel(T), self.model.n_particles,
+                  inputs=[s.x, s.v, s.F, s.clock, T(self.model.dx), T(MAX_CELLS_PER_STEP), self._bad],
+                  device=self.device)
+        bad = self._bad.numpy()
+        causes = [("x/v/F", "non-finite value (NaN or Inf)"),
+                  ("v", f"moved more than {MAX_CELLS_PER_STEP:g} cell in one step (|v| dt > dx): "
+                        "time step too large for this speed; lower time.cfl or time.dt"),
+                  ("F", "det F_E <= 0 (inverted element)")]
+        for k, (fld, cause) in enumerate(causes):
+            if bad[k] != INT_MAX:
+                t, dt, steps = self.stepper.clock()
+                raise SimulationBlowUp(steps, int(bad[k]), fld, f"{cause} at t = {t:.6g} s")
+
+    def step_to(self, t_end: float, health_every: int | None = None) -> int:
+        """Advance to ``t_end`` (s) exactly; return the steps taken.
+
+        Steps run in batches sized from the current step size; between batches
+        the host reads the clock and (every ``health_every`` steps) the health flags.
+        """
+        he = health_every or self.scenario.output.health_every
+        self.stepper.set_frame_end(t_end)
+        t, dt, steps0 = self.stepper.clock()
+        taken = 0
+        since_health = 0
+        while t < t_end * (1 - 1e-12) - 1e-15:
+            if dt <= 0:
+                dt = self._first_dt()
+            n = max(1, min(he, int(math.ceil((t_end - t) / dt))))
+            if self.step_actions:
+                for _ in range(n):
+                    for a in self.step_actions:
+                        a.launch()
+                    self.stepper.steps(1)
+            else:
+                self.stepper.steps(n)
+            t, dt_new, steps = self.stepper.clock()
+            taken = steps - steps0
+            since_health += n
+            if since_health >= he:
+                self.health()
+                since_health = 0
+            dt = dt_new if dt_new > 0 else dt
+        return taken
+
+    def _first_dt(self) -> float:
+        tc = self.scenario.time
+        if tc.dt > 0:
+            return tc.dt
+        d = tc.cfl * self.model.dx / self.model.c_p
+        return min(d, tc.dt_max) if tc.dt_max > 0 else d
+
+    # -------------------------------------------------------------------- run
+    def run(self, output: str | None = None, end_time: float | None = None, frame_interval: float | None = None,
+            callback: Callable[[Simulation, int], bool | None] | None = None, append: bool = False) -> RunResult:
+        """Run to ``end_time`` writing a frame every ``frame_interval``.
+
+        Parameters
+        ----------
+        output : str or None
+            HDF5 path; None runs without output.
+        end_time, frame_interval : float or None
+            Override the scenario's ``time.end`` / ``time.frame_interval`` (s).
+        callback : callable or None
+            ``callback(sim, frame)`` after every frame; returning False stops the run.
+        append : bool
+            Continue an existing output (used by :func:`resume`).
+
+        Returns
+        -------
+        RunResult
+        """
+        tc = self.scenario.time
+        end = tc.end if end_time is None else end_time
+        fi = tc.frame_interval if frame_interval is None else frame_interval
+        writer = None
+        ckpt = io.checkpoint_path_for(output) if output else None
+        n_frames_total = int(round(end / fi))
+        if output:
+            if append:
+                writer = io.RunWriter.reopen(output, keep_frames=self.frame_index + 1)
+            else:
+                writer = self._open_writer(output)
+                self._write_frame(writer)
+                self._checkpoint(ckpt)
+        # warm up: compile every kernel before timing
+        self._compile()
+        steps_total = 0
+        frames = 0
+        wall = 0.0
+        edge0 = int(self.stepper.edge_count.numpy()[0])
+        try:
+            while self.frame_index < n_frames_total:
+                t_next = min((self.frame_index + 1) * fi, end)
+                t0 = _time.perf_counter()
+                steps_total += self.step_to(t_next)
+                wp.synchronize_device(self.device)
+                wall += _time.perf_counter() - t0
+                self.frame_index += 1
+                frames += 1
+                if writer is not None:
+                    self._write_frame(writer)
+                    ce = self.scenario.output.checkpoint_every
+                    if ce and self.frame_index % ce == 0:
+                        self._checkpoint(ckpt)
+                if callback is not None and callback(self, self.frame_index) is False:
+                    break
+        except SimulationBlowUp as e:
+            e.output = output
+            e.checkpoint = ckpt if ckpt and os.path.exists(ckpt) else None
+            e.args = (str(SimulationBlowUp(e.step, e.particle, e.field, e.cause, e.checkpoint, e.output)),)
+            raise
+        finally:
+            if writer is not None:
+                writer.close()
+        n = self.model.n_particles
+        return RunResult(output, steps_total, frames, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
+                         n, self.device, int(self.stepper.edge_count.numpy()[0]) - edge0)
+
+    def _compile(self) -> None:
+        """Load every kernel of the plan (compiling on first use) without stepping."""
+        for m in {wp.get_module(k.kernel.module.name) for k in [self.stepper._begin, *self.stepper._p2g,
+                                                                  self.stepper._grid, self.stepper._g2p,
+                                                                  self.stepper._end]}:
+            m.load(self.device)
+
+    # ----------------------------------------------------------------- output
+    def _open_writer(self, path: str) -> io.RunWriter:
+        pf = {}
+        for name in self.scenario.output.fields:
+            shape, unit, _ = OUTPUT_FIELDS[name]
+            dt = "uint8" if name == "yielded" else self.scenario.precision
+            pf[name] = (shape, dt, unit)
+        group_id = np.zeros(self.model.n_particles, dtype=np.uint8)
+        for i, g in enumerate(self.model.groups):
+            group_id[g.start:g.end] = i
+        static = {"x0": (self.x0.astype(self.model.np_dtype), "m"), "group": (group_id, "1")}
+        scalars = {"kinetic_energy": "J", "elastic_energy": "J"}
+        for f in self.frame_diagnostics:
+            for k, unit in getattr(f, "units", {}).items():
+                scalars[k] = unit
+        attrs = {
+            "scenario": self.scenario.to_dict(),
+            "versions": versions(),
+            "device": self.device,
+            "precision": self.scenario.precision,
+            "groups": [{"name": g.name, "material": g.material_name, "start": g.start, "end": g.end,
+                        "mass": g.mass, "vol0": g.vol0} for g in self.model.groups],
+            "unit_system": "SI: m, s, kg, Pa, N, J",
+            "grid": {"origin": list(self.model.origin), "shape": list(self.model.grid_shape), "dx": self.model.dx},
+        }
+        return io.RunWriter(path, n_particles=self.model.n_particles, particle_fields=pf, static_fields=static,
+                            wall_names=self.model.wall_names, scalar_series=scalars, attrs=attrs)
+
+    def _write_frame(self, writer: io.RunWriter) -> None:
+        t, _, steps = self.stepper.clock()
+        parts = {name: self.particle_field(name) for name in self.scenario.output.fields}
+        scalars = self.energies()
+        for f in self.frame_diagnostics:
+            scalars.update(f(self))
+        imp = self.stepper.take_wall_impulse()
+        span = self.scenario.time.frame_interval
+        forces = imp / span if len(imp) else None
+        writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
+
+    def _checkpoint(self, path: str | None) -> None:
+        if path is None:
+            return
+        meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device}
+        io.write_checkpoint(path, self.state.arrays(), meta)
+
+
+def resume(output: str, device: str | None = None, end_time: float | None = None,
+           callback=None) -> RunResult:
+    """Continue the run stored in ``output`` from its last checkpoint.
+
+    The run file is truncated to the checkpoint's frame and extended; on the
+    CPU a resumed run matches an uninterrupted one bit for bit.
+    """
+    arrays, meta = io.read_checkpoint(io.checkpoint_path_for(output))
+    sc = Scenario.from_dict(meta["scenario"], source=output)
+    sim = Simulation(sc, device=device)
+    sim.state.load_arrays(arrays)
+    sim.frame_index = int(meta["frame_index"])
+    run = io.read_run(output)
+    sim.x0 = run.static["x0"].astype(np.float64)
+    return sim.run(output, end_time=end_time, callback=callback, append=True)

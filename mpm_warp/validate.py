@@ -1,0 +1,57 @@
+"""Small checks that turn bad input into :class:`InvalidArgument` naming the field."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from .errors import InvalidArgument
+
+
+def finite_number(field: str, value, *, lo=None, hi=None, lo_open=False, hi_open=False) -> float:
+    """Return ``value`` as a float, checking it is finite and within ``[lo, hi]``.
+
+    ``lo_open``/``hi_open`` make the bound strict. The error names the field,
+    the value and the allowed range.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InvalidArgument(field, value, "a number")
+    v = float(value)
+    lo_s = "-inf" if lo is None else f"{lo:g}"
+    hi_s = "inf" if hi is None else f"{hi:g}"
+    rng = f"{'(' if lo_open or lo is None else '['}{lo_s}, {hi_s}{')' if hi_open or hi is None else ']'}"
+    if not math.isfinite(v):
+        raise InvalidArgument(field, value, f"a finite number in {rng}")
+    if lo is not None and (v < lo or (lo_open and v == lo)):
+        raise InvalidArgument(field, value, f"a number in {rng}")
+    if hi is not None and (v > hi or (hi_open and v == hi)):
+        raise InvalidArgument(field, value, f"a number in {rng}")
+    return v
+
+
+def vector3(field: str, value, *, nonzero: bool = False) -> tuple[float, float, float]:
+    """Return ``value`` as a tuple of three finite floats."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)) or len(value) != 3:
+        raise InvalidArgument(field, value, "a list of 3 numbers")
+    out = tuple(finite_number(f"{field}[{i}]", c) for i, c in enumerate(value))
+    if nonzero and all(c == 0.0 for c in out):
+        raise InvalidArgument(field, value, "a non-zero vector")
+    return out
+
+
+def choice(field: str, value, allowed: Sequence[str]) -> str:
+    """Check that ``value`` is one of ``allowed`` (strings)."""
+    if value not in allowed:
+        raise InvalidArgument(field, value, "one of " + ", ".join(repr(a) for a in allowed))
+    return value
+
+
+def positive_int(field: str, value, *, lo: int = 1, hi: int | None = None) -> int:
+    """Check an integer in ``[lo, hi]``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InvalidArgument(field, value, "an integer")
+    if value < lo or (hi is not None and value > hi):
+        raise InvalidArgument(field, value, f"an integer in [{lo}, {hi if hi is not None else 'inf'}]")
+    return int(value)

@@ -1,0 +1,1 @@
+"""Ready scenes (TOML files), installed as ``mpm_warp.scenarios``."""
