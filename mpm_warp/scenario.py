@@ -367,8 +367,8 @@ def read_scenario_dict(path_or_name: str) -> tuple[dict, str]:
         fname = path_or_name if path_or_name.endswith(".toml") else path_or_name + ".toml"
         cand = os.path.join(scenarios_dir(), fname)
         if not os.path.exists(cand):
-            raise ScenarioError(f"scenario {path_or_name!r} not found (neither a file nor a scene in {scenarios_dir()}; "
-                                f"known scenes: {', '.join(list_scenes())})")
+            raise ScenarioError(f"scenario {path_or_name!r} not found (neither a file nor a scene in "
+                                f"{scenarios_dir()}; known scenes: {', '.join(list_scenes())})")
         path = cand
     try:
         with open(path, "rb") as fh:
