@@ -50,7 +50,7 @@ def g2p_kernel(T):
                 for d in range(3):
                     w = W[a, 0] * W[c, 1] * W[d, 2]
                     g = grid_v[b[0] + a, b[1] + c, b[2] + d]
-                    dpos = (V(T(a), T(c), T(d)) - fx) * dx
+                    dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
                     vn += w * g
                     B += w * wp.outer(g, dpos)
         xn = x[i] + dt * vn

@@ -102,7 +102,7 @@ def p2g_kernel(T, plastic: bool, track_yield: bool):
             for c in range(3):
                 for d in range(3):
                     w = W[a, 0] * W[c, 1] * W[d, 2]
-                    dpos = (V(T(a), T(c), T(d)) - fx) * dx
+                    dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
                     wp.atomic_add(grid_m, b[0] + a, b[1] + c, b[2] + d, w * mass)
                     wp.atomic_add(grid_p, b[0] + a, b[1] + c, b[2] + d, w * (mv + A * dpos))
 

@@ -21,7 +21,7 @@ from .kernels.types import mat33, vec3
 from .materials import CamClaySnow, Elastic
 from .scenario import Scenario
 
-__all__ = ["Model", "State", "ParticleGroup", "seed_block", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
+__all__ = ["Model", "State", "ParticleGroup", "seed_block", "velocity_gradient", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
 
 #: floor of the singular values of F_E (-) used by the floored Hencky log (MODEL.md 1)
 SINGULAR_VALUE_FLOOR = 1e-6
@@ -68,6 +68,21 @@ def seed_block(lo, hi, dx: float, ppc: int) -> tuple[np.ndarray, float]:
     vol = float(np.prod([(hi[a] - lo[a]) / len(axes[a]) for a in range(3)]))
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
     return np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1), vol
+
+
+def velocity_gradient(field, x: np.ndarray, h: float) -> np.ndarray:
+    """Central-difference gradient ``dv_i/dx_j`` (1/s) of a velocity function at points ``x`` (n, 3).
+
+    Used to start APIC/MLS particles with the affine matrix ``C = grad v`` of a
+    prescribed initial velocity field, so a rigid spin or shear starts without
+    the energy loss of ``C = 0``.
+    """
+    grad = np.zeros((len(x), 3, 3))
+    for j in range(3):
+        e = np.zeros(3)
+        e[j] = h
+        grad[:, :, j] = (np.asarray(field(x + e)) - np.asarray(field(x - e))) / (2.0 * h)
+    return grad
 
 
 class Model:
@@ -168,15 +183,19 @@ class Model:
         """Allocate and fill the state at t = 0."""
         x = np.concatenate([s[1] for s in self._seed]).astype(self.np_dtype)
         v = np.zeros_like(x)
+        C = np.zeros((len(x), 3, 3), dtype=self.np_dtype)
         for g, (b, xb) in zip(self.groups, self._seed, strict=True):
-            vel = b.velocity(xb) if callable(b.velocity) else np.broadcast_to(np.asarray(b.velocity), xb.shape)
-            v[g.start:g.end] = vel
+            if callable(b.velocity):
+                v[g.start:g.end] = b.velocity(xb)
+                C[g.start:g.end] = velocity_gradient(b.velocity, xb, 1e-3 * self.dx)
+            else:
+                v[g.start:g.end] = np.broadcast_to(np.asarray(b.velocity), xb.shape)
         ljp = np.zeros(self.n_plastic, dtype=self.np_dtype)
         for g in self.groups:
             if g.material.plastic:
                 assert isinstance(g.material, CamClaySnow)
                 ljp[g.plastic_start:g.plastic_start + g.count] = g.material.initial_log_jp
-        return State(self, x, v, ljp, track_yield)
+        return State(self, x, v, C, ljp, track_yield)
 
     def bytes_per_particle(self, state: State) -> float:
         """Device bytes of particle fields per particle (grid excluded)."""
@@ -204,7 +223,7 @@ class State:
         Steps taken.
     """
 
-    def __init__(self, model: Model, x, v, log_jp, track_yield: bool):
+    def __init__(self, model: Model, x, v, C, log_jp, track_yield: bool):
         dev = model.device
         T = model.T
         V, M = vec3(T), mat33(T)
@@ -212,7 +231,7 @@ class State:
         self.model = model
         self.x = wp.array(x, dtype=V, device=dev)
         self.v = wp.array(v.astype(model.np_dtype), dtype=V, device=dev)
-        self.C = wp.zeros(n, dtype=M, device=dev)
+        self.C = wp.array(C, dtype=M, device=dev)
         self.F = wp.array(np.tile(np.eye(3, dtype=model.np_dtype), (n, 1, 1)), dtype=M, device=dev)
         self.log_jp = wp.array(log_jp, dtype=T, device=dev) if model.n_plastic else None
         track = track_yield and model.n_plastic > 0
