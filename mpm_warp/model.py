@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from .kernels.camclay import SINGULAR_VALUE_FLOOR
 from .kernels.grid_update import wall_struct
 from .kernels.types import mat33, vec3
 from .materials import CamClaySnow, Elastic
@@ -23,8 +24,6 @@ from .scenario import Scenario
 
 __all__ = ["Model", "State", "ParticleGroup", "seed_block", "velocity_gradient", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
 
-#: floor of the singular values of F_E (-) used by the floored Hencky log (MODEL.md 1)
-SINGULAR_VALUE_FLOOR = 1e-6
 #: grid nodes added outside the domain box on each side
 GRID_PADDING = 3
 

@@ -1,0 +1,311 @@
+"""Modified Cam-Clay with cohesion: yield, hardening and return mapping.
+
+Implements MODEL.md sections 2-4 (Gaume et al. 2018, Supplementary Note 1).
+Stresses are Kirchhoff, in Pa, compression positive:
+
+    p = -K tr(eps),   q = sqrt(6) mu |dev eps|,   K = lam + 2 mu / 3
+    y(p, q) = (1 + 2 beta) q^2 + M^2 (p + beta p0)(p - p0)          (yield, <= 0)
+    p0 = K sinh(xi max(-log_Jp, 0))                                  (hardening)
+
+with ``eps = ln s`` the principal Hencky strains of the elastic deformation
+gradient. Every device function comes from a cached factory of the scalar type
+``T`` (``wp.float32`` or ``wp.float64``).
+
+Numerical constants (fixed, not model parameters)
+--------------------------------------------------
+``SINGULAR_VALUE_FLOOR`` (1e-6): singular values are floored there before the
+logarithm, so an inverted or nearly singular ``F_E`` gives finite strains
+(``|eps_i| <= 13.8`` on the compressive side). The engine should pass the same
+value as ``s_floor`` to :func:`mpm_warp.kernels.elasticity.hencky_func`.
+``p0`` is capped at ``-3 K ln(SINGULAR_VALUE_FLOOR)`` (about 41.4 K), the
+pressure of the most compressed representable state, which keeps ``sinh``
+and ``exp`` finite for any ``log_Jp``.
+"""
+
+import functools
+import math
+
+import warp as wp
+
+from .types import vec3
+
+__all__ = [
+    "SINGULAR_VALUE_FLOOR",
+    "camclay_p0_func",
+    "camclay_pq_func",
+    "camclay_return_func",
+    "camclay_yield_func",
+    "initial_log_jp",
+]
+
+SINGULAR_VALUE_FLOOR = 1.0e-6
+"""Floor on singular values before ``ln`` (dimensionless); fixed, not tunable."""
+
+_SQRT6 = math.sqrt(6.0)
+_P0_CAP_OVER_K = -3.0 * math.log(SINGULAR_VALUE_FLOOR)
+_MAX_ROOT_ITERATIONS = 100
+
+
+def initial_log_jp(p0_ini, K, xi):
+    """Initial hardening state for a consolidation pressure (MODEL.md section 3).
+
+    Parameters
+    ----------
+    p0_ini : float
+        Initial consolidation pressure ``p0(0)`` (Pa, >= 0).
+    K : float
+        Bulk modulus (Pa, > 0).
+    xi : float
+        Hardening coefficient (dimensionless, > 0).
+
+    Returns
+    -------
+    float
+        ``log_Jp(0) = -asinh(p0_ini / K) / xi`` (dimensionless, <= 0).
+    """
+    return -math.asinh(float(p0_ini) / float(K)) / float(xi)
+
+
+@functools.cache
+def camclay_yield_func(T):
+    """Build ``camclay_yield(p, q, p0, M, beta) -> T`` (Pa^2).
+
+    ``y = (1 + 2 beta) q^2 + M^2 (p + beta p0)(p - p0)`` (MODEL.md section 2);
+    ``y <= 0`` inside the ellipse through ``p = -beta p0`` and ``p = p0``.
+    """
+
+    @wp.func
+    def camclay_yield(p: T, q: T, p0: T, M: T, beta: T):
+        return (T(1.0) + T(2.0) * beta) * q * q + M * M * (p + beta * p0) * (p - p0)
+
+    return camclay_yield
+
+
+@functools.cache
+def camclay_p0_func(T):
+    """Build ``camclay_p0(log_jp, K, xi, p0_floor) -> T``: consolidation pressure (Pa).
+
+    ``p0 = max(K sinh(xi max(-log_jp, 0)), p0_floor)`` (MODEL.md section 3),
+    capped at ``-3 K ln(SINGULAR_VALUE_FLOOR)`` (about 41.4 K) so it stays finite.
+    """
+    cap = _P0_CAP_OVER_K
+    x_cap = math.asinh(cap)
+
+    @wp.func
+    def camclay_p0(log_jp: T, K: T, xi: T, p0_floor: T):
+        x = wp.min(xi * wp.max(-log_jp, T(0.0)), T(x_cap))
+        return wp.max(K * wp.sinh(x), p0_floor)
+
+    return camclay_p0
+
+
+@functools.cache
+def camclay_pq_func(T):
+    """Build ``camclay_pq(sig, mu, lam) -> (p, q)`` from singular values of ``F_E``.
+
+    ``sig`` (vec3, dimensionless) is floored at ``SINGULAR_VALUE_FLOOR``;
+    returns ``p = -K tr(eps)`` and ``q = sqrt(6) mu |dev eps|`` (Pa, MODEL.md
+    section 1), equal to ``-tr(tau)/3`` and ``sqrt(3/2)|dev tau|`` of the Hencky law.
+    """
+    v3 = vec3(T)
+    s_floor = SINGULAR_VALUE_FLOOR
+    sqrt6 = _SQRT6
+
+    @wp.func
+    def camclay_pq(sig: v3, mu: T, lam: T):
+        sf = T(s_floor)
+        eps = v3(wp.log(wp.max(sig[0], sf)), wp.log(wp.max(sig[1], sf)), wp.log(wp.max(sig[2], sf)))
+        tr = eps[0] + eps[1] + eps[2]
+        m = tr / T(3.0)
+        dev = v3(eps[0] - m, eps[1] - m, eps[2] - m)
+        if eps[0] == eps[1] and eps[1] == eps[2]:
+            dev = v3(T(0.0), T(0.0), T(0.0))
+        K = lam + T(2.0) / T(3.0) * mu
+        return -K * tr, T(sqrt6) * mu * wp.length(dev)
+
+    return camclay_pq
+
+
+@functools.cache
+def _ellipse_closest_func(T):
+    """Closest point of the ellipse ``(x0/e0)^2 + (x1/e1)^2 = 1`` to ``(y0, y1)``.
+
+    First quadrant only (``y0, y1 >= 0``), ``e0 >= e1 >= 0``, point outside or
+    on the ellipse (the inside is never asked for). Follows Eberly's
+    parametrisation ``x0 = r0 y0 / (s + r0)``, ``x1 = y1 / (s + 1)``,
+    ``r0 = (e0/e1)^2``, with ``s >= 0`` the root of the convex decreasing
+    ``F(s) = (r0 z0 / (s + r0))^2 + (z1 / (s + 1))^2 - 1``, ``z = y / e``.
+    The root is bracketed by ``[max(0, z1 - 1, r0 (z0 - 1)), |(r0 z0, z1)| - 1]``
+    and found by Newton steps from the left end (they never overshoot on a
+    convex decreasing function) interleaved with bisection, so each iteration
+    at least halves the bracket. Stops when ``0 <= F(s) <= 4 eps`` (``F`` is
+    the ellipse equation at the point, i.e. the yield function over
+    ``M^2 a^2``), when the bracket is below ``4 eps (1 + s)``, or after 100
+    iterations (typically 1-4, at most about 30 for aspect ratios of 1e4).
+    """
+    eps = 4.0 * (2.0**-23 if T == wp.float32 else 2.0**-52)
+    max_it = _MAX_ROOT_ITERATIONS
+
+    @wp.func
+    def root_f(s: T, n0: T, r0: T, z1: T):
+        a = n0 / (s + r0)
+        b = z1 / (s + T(1.0))
+        return a * a + b * b - T(1.0), T(-2.0) * (a * a / (s + r0) + b * b / (s + T(1.0)))
+
+    @wp.func
+    def ellipse_closest(e0: T, e1: T, y0: T, y1: T):
+        if e1 <= T(0.0):  # degenerate ellipse: the segment [-e0, e0] x {0}
+            return wp.min(y0, e0), T(0.0)
+        if y1 <= T(0.0):  # on the major axis, outside: the vertex
+            return e0, T(0.0)
+        if y0 <= T(0.0):  # on the minor axis, outside: the co-vertex
+            return T(0.0), e1
+        z0 = y0 / e0
+        z1 = y1 / e1
+        if z0 * z0 + z1 * z1 <= T(1.0):  # on the ellipse within rounding
+            return y0, y1
+        r0 = (e0 / e1) * (e0 / e1)
+        n0 = r0 * z0
+        m = wp.max(n0, z1)
+        lo = wp.max(T(0.0), wp.max(z1 - T(1.0), n0 - r0))
+        hi = wp.max(lo, m * wp.sqrt((n0 / m) * (n0 / m) + (z1 / m) * (z1 / m)) - T(1.0))
+        f_lo, df_lo = root_f(lo, n0, r0, z1)
+        it = int(0)  # noqa: UP018 (a mutable Warp int, not a constant)
+        while it < max_it and f_lo > T(eps) and hi - lo > T(eps) * (T(1.0) + lo):
+            it += 1
+            s = lo
+            if df_lo < T(0.0):
+                s = wp.min(wp.max(lo - f_lo / df_lo, lo), hi)
+            f, df = root_f(s, n0, r0, z1)
+            if f >= T(0.0):
+                lo = s
+                f_lo = f
+                df_lo = df
+            else:
+                hi = s
+            if f_lo > T(eps) and hi - lo > T(eps) * (T(1.0) + lo):
+                s = T(0.5) * (lo + hi)
+                f, df = root_f(s, n0, r0, z1)
+                if f >= T(0.0):
+                    lo = s
+                    f_lo = f
+                    df_lo = df
+                else:
+                    hi = s
+        return r0 * y0 / (lo + r0), y1 / (lo + T(1.0))
+
+    return ellipse_closest
+
+
+@functools.cache
+def camclay_return_func(T):
+    """Build the Cam-Clay return mapping ``camclay_return`` for scalar type ``T``.
+
+    Signature of the returned ``wp.func``::
+
+        camclay_return(sig: vec3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T,
+                       p0_floor: T) -> (sig_new: vec3, log_jp_new: T, yielded: int32)
+
+    Parameters
+    ----------
+    sig : vec3
+        Singular values of the trial elastic deformation gradient ``F_E_tr``
+        (dimensionless, as from ``wp.svd3``: descending, the last possibly
+        negative or tiny; floored at ``SINGULAR_VALUE_FLOOR`` before ``ln``).
+    log_jp : T
+        Hardening state ``ln det F_P`` (dimensionless).
+    mu, lam : T
+        Lame parameters (Pa). M : slope of the critical state line; beta :
+        cohesion ratio (>= 0); xi : hardening coefficient (> 0), dimensionless.
+    p0_floor : T
+        Floor on ``p0`` (Pa; e.g. 1e-5 K, keep it above ~1e-20 K so that the
+        scaled trial state stays representable), see :func:`camclay_p0_func`.
+
+    Returns
+    -------
+    sig_new : vec3
+        Singular values of the new ``F_E`` (same ``U``, ``V``). For an elastic
+        trial (``y <= 0``) the input ``sig`` itself, bit for bit.
+    log_jp_new : T
+        ``log_jp + tr(eps_tr) - tr(eps_new)`` (hardening applied after the
+        projection, explicit in ``p0``; MODEL.md section 4).
+    yielded : int32
+        1 if a projection happened, 0 otherwise.
+
+    Notes
+    -----
+    The discrete flow rule ``eps_tr - eps_new = dgamma dy/dtau`` (SI Eq. 4) with
+    Hencky elasticity maps ``(p, q)`` by ``-dgamma diag(K, 3 mu) grad y``: the
+    new state is the point of the ellipse closest to ``(p_tr, q_tr)`` in the
+    energy metric ``dp^2/K + dq^2/(3 mu)`` (SI Eq. 5, "ray-ellipse
+    intersection"). In the scaled coordinates ``u = (p - pc)/a``,
+    ``v = q sqrt(K/(3 mu))/a`` (``pc = p0 (1 - beta)/2``, ``a = p0 (1 + beta)/2``)
+    the ellipse has semi-axes ``1`` and ``c = M sqrt(K/(3 mu (1 + 2 beta)))``
+    and the Euclidean closest point is found in the first quadrant
+    (``q >= 0``, mirrored in ``p``). Then ``tr(eps_new) = -p_new/K`` and
+    ``dev(eps_new) = dev(eps_tr) q_new/q_tr`` (direction kept).
+
+    Edge cases: ``q_tr = 0`` (repeated singular values, direction undefined,
+    ``dev eps`` stays 0) goes to the nearer tip, ``p0`` or ``-beta p0``; a
+    trial beyond the cap or the tensile tip is handled by the same
+    closest-point search; ``p0`` at its floor shrinks the ellipse to a tiny
+    one around ``pc`` (no division by ``p0``); ``p0 <= 0`` (only if
+    ``p0_floor <= 0``) returns the stress-free state; ``beta = 0`` puts the
+    tensile tip at ``p = 0``. ``q_new <= q_tr`` and ``|p_new| <= 41.4 K``, so
+    ``sig_new`` is finite and positive for any finite input.
+    """
+    v3 = vec3(T)
+    s_floor = SINGULAR_VALUE_FLOOR
+    sqrt6 = _SQRT6
+    yield_fn = camclay_yield_func(T)
+    p0_fn = camclay_p0_func(T)
+    closest = _ellipse_closest_func(T)
+
+    @wp.func
+    def camclay_return(sig: v3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T):
+        sf = T(s_floor)
+        eps = v3(wp.log(wp.max(sig[0], sf)), wp.log(wp.max(sig[1], sf)), wp.log(wp.max(sig[2], sf)))
+        tr = eps[0] + eps[1] + eps[2]
+        m = tr / T(3.0)
+        dev = v3(eps[0] - m, eps[1] - m, eps[2] - m)
+        if eps[0] == eps[1] and eps[1] == eps[2]:
+            dev = v3(T(0.0), T(0.0), T(0.0))  # repeated singular values: tr/3 may round off eps
+        K = lam + T(2.0) / T(3.0) * mu
+        p_tr = -K * tr
+        q_tr = T(sqrt6) * mu * wp.length(dev)
+        p0 = p0_fn(log_jp, K, xi, p0_floor)
+        if yield_fn(p_tr, q_tr, p0, M, beta) <= T(0.0):
+            return sig, log_jp, wp.int32(0)
+
+        p_new = T(0.0)
+        q_new = T(0.0)
+        a = T(0.5) * p0 * (T(1.0) + beta)
+        if a > T(0.0):
+            pc = T(0.5) * p0 * (T(1.0) - beta)
+            rho = wp.sqrt(T(3.0) * mu / K)  # q = a rho v
+            c = M / (wp.sqrt(T(1.0) + T(2.0) * beta) * rho)
+            du = p_tr - pc
+            u = wp.abs(du) / a
+            v = q_tr / (a * rho)
+            xu = T(0.0)
+            xv = T(0.0)
+            if c <= T(1.0):
+                xu, xv = closest(T(1.0), c, u, v)
+            else:
+                xv, xu = closest(c, T(1.0), v, u)
+            if du < T(0.0):  # measured from the nearer tip: exact there, even for beta >> 1
+                p_new = -beta * p0 + a * (T(1.0) - xu)
+            else:
+                p_new = p0 - a * (T(1.0) - xu)
+            q_new = a * rho * xv
+
+        scale = T(0.0)
+        if q_tr > T(0.0):
+            scale = wp.min(q_new / q_tr, T(1.0))
+        m_new = -p_new / (T(3.0) * K)
+        sig_new = v3(
+            wp.exp(dev[0] * scale + m_new), wp.exp(dev[1] * scale + m_new), wp.exp(dev[2] * scale + m_new)
+        )
+        return sig_new, log_jp + tr - T(3.0) * m_new, wp.int32(1)
+
+    return camclay_return
