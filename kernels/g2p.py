@@ -5,15 +5,17 @@
 
 Edge policy: a particle whose new position leaves the safe interior of the
 grid (where its 3x3x3 stencil still fits) is clamped to it and counted in
-``edge_count[0]``; the driver reports the count, so no write can ever go out of
-bounds.
+``edge_count[0]``; the driver reports the count. A particle whose stencil is
+not inside the grid at all (only possible for a non-finite position) is
+skipped and counted in ``edge_count[1]``; the health check then stops the run.
+No write can go out of bounds.
 """
 
 import functools
 
 import warp as wp
 
-from .shape import stencil_func
+from .shape import in_grid, stencil_func
 from .types import mat33, vec3
 
 
@@ -43,6 +45,10 @@ def g2p_kernel(T):
         if dt <= T(0.0):
             return
         b, fx, W = stencil(x[i], origin, inv_dx)
+        if not in_grid(b, grid_v.shape[0], grid_v.shape[1], grid_v.shape[2]):
+            # only a non-finite position gets here (positions are clamped below)
+            wp.atomic_add(edge_count, 1, 1)
+            return
         vn = V(T(0.0), T(0.0), T(0.0))
         B = M()
         for a in range(3):

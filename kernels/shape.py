@@ -44,3 +44,13 @@ def stencil_func(T):
         return b, fx, W
 
     return stencil
+
+
+@wp.func
+def in_grid(b: wp.vec3i, nx: int, ny: int, nz: int):
+    """True when the 3x3x3 stencil based at node ``b`` lies inside a grid of ``nx * ny * nz`` nodes.
+
+    Also false for the garbage index a non-finite position produces, so kernels
+    never read or write out of bounds.
+    """
+    return b[0] >= 0 and b[1] >= 0 and b[2] >= 0 and b[0] <= nx - 3 and b[1] <= ny - 3 and b[2] <= nz - 3

@@ -298,8 +298,8 @@ def _check_keys(d: dict, allowed: set, prefix: str, source: str):
     for k in d:
         if k not in allowed:
             close = difflib.get_close_matches(k, sorted(allowed), n=1)
-            hint = f" (did you mean {prefix}{close[0]!r}?)" if close else ""
-            raise ScenarioError(f"{source}: unknown key {prefix}{k!r}{hint}; allowed: {', '.join(sorted(allowed))}")
+            hint = f" (did you mean '{prefix}{close[0]}'?)" if close else ""
+            raise ScenarioError(f"{source}: unknown key '{prefix}{k}'{hint}; allowed: {', '.join(sorted(allowed))}")
 
 
 def _section(cls, d, where: str, source: str):

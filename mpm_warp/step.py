@@ -43,7 +43,8 @@ class Stepper:
         self.grid_p = wp.zeros(model.grid_shape, dtype=V, device=dev)
         self.dt = wp.zeros(1, dtype=T, device=dev)
         self.vmax = wp.zeros(1, dtype=T, device=dev)
-        self.edge_count = wp.zeros(1, dtype=wp.int32, device=dev)
+        # [particles clamped at the grid edge, particles skipped with a stencil outside the grid]
+        self.edge_count = wp.zeros(2, dtype=wp.int32, device=dev)
         has_walls = bool(model.walls)
         self.wall_impulse = wp.zeros(len(model.walls), dtype=V, device=dev) if has_walls else None
         self.fixed_dt = model.scenario.time.dt
@@ -74,7 +75,8 @@ class Stepper:
             self._p2g.append(wp.launch(
                 k, g.count,
                 inputs=[s.x[sl], s.v[sl], s.C[sl], s.F[sl], ljp, yld, T(g.mass), T(g.vol0), T(mat.mu), T(mat.lam),
-                        *cc, T(SINGULAR_VALUE_FLOOR), self.dt, origin, inv_dx, dx, self.grid_m, self.grid_p],
+                        *cc, T(SINGULAR_VALUE_FLOOR), self.dt, origin, inv_dx, dx, self.grid_m, self.grid_p,
+                        self.edge_count[1:]],
                 device=dev, record_cmd=True))
         self._grid = wp.launch(
             grid_update_kernel(T, has_walls), model.grid_shape,

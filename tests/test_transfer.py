@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 import warp as wp
-from mpm_warp.kernels.shape import stencil_func
-from mpm_warp.kernels.types import vec3
 
 import mpm_warp
+from mpm_warp.kernels.shape import stencil_func
+from mpm_warp.kernels.types import vec3
 
 
 @pytest.fixture(scope="module", params=["float32", "float64"])
