@@ -1,0 +1,155 @@
+"""Command line: ``mpm-warp run|resume|scenes|info ...``.
+
+Errors the library raises on purpose (bad input, blow-ups) are printed as one
+clear line with exit status 2 (input) or 3 (simulation), never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+from .errors import MPMError, SimulationBlowUp
+
+__all__ = ["main"]
+
+
+class Progress:
+    """Frame callback printing sim time, steps, speed and ETA on one line (stderr)."""
+
+    def __init__(self, end_time: float, stream=sys.stderr, every: float = 0.5):
+        self.end = end_time
+        self.stream = stream
+        self.every = every
+        self.t0 = time.perf_counter()
+        self.last = 0.0
+
+    def __call__(self, sim, frame: int):
+        now = time.perf_counter()
+        t = sim.time
+        if now - self.last < self.every and t < self.end:
+            return None
+        self.last = now
+        elapsed = now - self.t0
+        frac = min(t / self.end, 1.0) if self.end > 0 else 1.0
+        eta = elapsed * (1 - frac) / frac if frac > 0 else float("inf")
+        steps = int(sim.state.steps.numpy()[0])
+        bar = "#" * int(30 * frac) + "." * (30 - int(30 * frac))
+        self.stream.write(f"\r[{bar}] t = {t:.4g}/{self.end:.4g} s  frame {frame}  steps {steps}  "
+                          f"elapsed {elapsed:.1f} s  ETA {eta:.1f} s ")
+        self.stream.flush()
+        return None
+
+    def close(self):
+        self.stream.write("\n")
+
+
+def _summary(res, out=sys.stdout):
+    out.write(
+        f"done: {res.frames} frames, {res.steps} steps, t = {res.sim_time:.6g} s, {res.n_particles} particles on "
+        f"{res.device}; stepping {res.wall_time:.2f} s ({res.particle_steps_per_s / 1e6:.2f} M particle-steps/s)"
+        + (f"; {res.edge_hits} particle clamps at the grid edge" if res.edge_hits else "")
+        + (f"\noutput: {res.output}" if res.output else "") + "\n")
+    for k, v in res.extra.items():
+        out.write(f"  {k}: {v}\n")
+
+
+def cmd_run(a) -> int:
+    from .scenario import load_scenario
+    from .simulation import Simulation
+
+    sc = load_scenario(a.scenario, a.set)
+    sim = Simulation(sc, device=a.device)
+    prog = None if a.quiet else Progress(sc.time.end)
+    try:
+        res = sim.run(a.out, callback=prog)
+    finally:
+        if prog:
+            prog.close()
+    _summary(res)
+    if a.json:
+        print(json.dumps(res.__dict__, default=str))
+    return 0
+
+
+def cmd_resume(a) -> int:
+    from .simulation import resume
+
+    res = resume(a.run, device=a.device, end_time=a.end)
+    _summary(res)
+    return 0
+
+
+def cmd_scenes(a) -> int:
+    from .scenario import list_scenes, read_scenario_dict
+
+    for name in list_scenes():
+        raw, _ = read_scenario_dict(name)
+        print(f"{name:20s} {raw.get('description', '')}")
+    return 0
+
+
+def cmd_info(a) -> int:
+    from .simulation import versions
+
+    print(json.dumps(versions(), indent=1))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser (extended by the render, plot and sweep commands)."""
+    p = argparse.ArgumentParser(prog="mpm-warp", description="MPM in NVIDIA Warp for anticrack propagation in snow")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    r = sub.add_parser("run", help="run a scenario file or a ready scene")
+    r.add_argument("scenario", help="path to a .toml scenario, or the name of a ready scene (see `mpm-warp scenes`)")
+    r.add_argument("--out", default=None, help="HDF5 output file (default: no output)")
+    r.add_argument("--device", default=None,
+                   help="cpu | cuda | cuda:N (default: MPM_WARP_DEVICE, then CUDA if present)")
+    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scenario value, e.g. --set time.end=0.5 --set materials.slab.E=2e6")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument("--json", action="store_true", help="print the run summary as JSON")
+    r.set_defaults(func=cmd_run)
+
+    rs = sub.add_parser("resume", help="continue a run from its last checkpoint")
+    rs.add_argument("run", help="the run's HDF5 file (its checkpoint RUN.ckpt.h5 must sit beside it)")
+    rs.add_argument("--device", default=None)
+    rs.add_argument("--end", type=float, default=None, help="new end time (s)")
+    rs.set_defaults(func=cmd_resume)
+
+    sc = sub.add_parser("scenes", help="list the ready scenes")
+    sc.set_defaults(func=cmd_scenes)
+    info = sub.add_parser("info", help="versions")
+    info.set_defaults(func=cmd_info)
+
+    for mod in ("render", "plots", "sweep"):
+        try:
+            m = __import__(f"mpm_warp.{mod}", fromlist=["add_cli"])
+        except ImportError:
+            continue
+        if hasattr(m, "add_cli"):
+            m.add_cli(sub)
+    return p
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``mpm-warp`` command."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except SimulationBlowUp as e:
+        print(f"mpm-warp: {e}", file=sys.stderr)
+        return 3
+    except MPMError as e:
+        print(f"mpm-warp: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("mpm-warp: interrupted; complete frames are kept in the output file", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
