@@ -89,6 +89,8 @@ def grid_update_kernel(T, has_walls: bool):
         clock: wp.array(dtype=wp.float64),
         gravity: V,
         gravity_ramp: T,
+        damping: T,
+        damping_until: T,
         mass_threshold: T,
         origin: V,
         dx: T,
@@ -109,6 +111,8 @@ def grid_update_kernel(T, has_walls: bool):
         if gravity_ramp > T(0.0):
             g_scale = wp.min(t / gravity_ramp, T(1.0))
         vel = grid_p[i, j, k] / m + (dt * g_scale) * gravity
+        if t < damping_until:
+            vel = vel * wp.max(T(1.0) - damping * dt, T(0.0))
         if wp.static(has_walls):
             xn = origin + V(T(i), T(j), T(k)) * dx
             for w in range(walls.shape[0]):

@@ -117,6 +117,12 @@ class TimeControl:
         Gravitational acceleration (m/s^2); a slope is a rotated gravity.
     gravity_ramp : float
         Gravity grows linearly from 0 over this time (s); 0 = full at once.
+    damping : float
+        Grid velocity damping rate (1/s) applied while ``t < damping_until``:
+        ``v *= max(0, 1 - damping dt)``; for settling a scene to rest before the
+        experiment starts. 0 = none.
+    damping_until : float
+        Time (s) at which the damping stops.
     """
 
     end: float
@@ -126,6 +132,8 @@ class TimeControl:
     dt_max: float = 0.0
     gravity: tuple = (0.0, -9.81, 0.0)
     gravity_ramp: float = 0.0
+    damping: float = 0.0
+    damping_until: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -190,7 +198,9 @@ class Scenario:
         dt_max = finite_number("time.dt_max", t.dt_max, lo=0.0)
         g = vector3("time.gravity", t.gravity)
         ramp = finite_number("time.gravity_ramp", t.gravity_ramp, lo=0.0)
-        tc = TimeControl(end, fi, cfl, dt, dt_max, g, ramp)
+        damp = finite_number("time.damping", t.damping, lo=0.0)
+        damp_until = finite_number("time.damping_until", t.damping_until, lo=0.0)
+        tc = TimeControl(end, fi, cfl, dt, dt_max, g, ramp, damp, damp_until)
 
         if not self.materials:
             raise InvalidArgument("materials", {}, "at least one material")

@@ -108,8 +108,6 @@ class Simulation:
         self.x0 = self.state.x.numpy().astype(np.float64)
         #: functions ``f(sim) -> dict[str, float]`` evaluated at every frame and stored as scalar series
         self.frame_diagnostics: list[Callable[[Simulation], dict]] = []
-        #: objects with ``launch()`` run on the device before every step (e.g. a saw)
-        self.step_actions: list = []
         self._bad = wp.full(3, INT_MAX, dtype=wp.int32, device=self.device)
         self._energy = wp.zeros(2, dtype=wp.float64, device=self.device)
 
@@ -208,13 +206,7 @@ class Simulation:
             if dt <= 0:
                 dt = self._first_dt()
             n = max(1, min(he, int(math.ceil((t_end - t) / dt))))
-            if self.step_actions:
-                for _ in range(n):
-                    for a in self.step_actions:
-                        a.launch()
-                    self.stepper.steps(1)
-            else:
-                self.stepper.steps(n)
+            self.stepper.steps(n)
             t, dt_new, steps = self.stepper.clock()
             taken = steps - steps0
             since_health += n

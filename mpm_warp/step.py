@@ -81,7 +81,7 @@ class Stepper:
         self._grid = wp.launch(
             grid_update_kernel(T, has_walls), model.grid_shape,
             inputs=[self.grid_m, self.grid_p, self.dt, s.clock, V(*model.gravity), T(tc.gravity_ramp),
-                    T(model.mass_threshold), origin, dx, model.walls_device, self.wall_impulse, self.vmax],
+                    T(tc.damping), T(tc.damping_until if tc.damping > 0 else 0.0), T(model.mass_threshold), origin, dx, model.walls_device, self.wall_impulse, self.vmax],
             device=dev, record_cmd=True)
         self._g2p = wp.launch(
             g2p_kernel(T), model.n_particles,
@@ -91,10 +91,15 @@ class Stepper:
         self._end = wp.launch(end_step_kernel(), 1, inputs=[s.clock, s.steps], device=dev, record_cmd=True)
         self.use_graph = wp.get_device(dev).is_cuda if use_graph is None else use_graph
         self._graphs: dict[int, object] = {}
+        #: recorded launches (``.launch()``) run at the start of every step, after the step size is set
+        #: (e.g. a saw advancing through a weak layer); add them before the first call of :meth:`steps`.
+        self.actions: list = []
 
     # ------------------------------------------------------------------ steps
     def _launch_step(self) -> None:
         self._begin.launch()
+        for a in self.actions:
+            a.launch()
         self.grid_m.zero_()
         self.grid_p.zero_()
         for k in self._p2g:
