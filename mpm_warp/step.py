@@ -81,7 +81,8 @@ class Stepper:
         self._grid = wp.launch(
             grid_update_kernel(T, has_walls), model.grid_shape,
             inputs=[self.grid_m, self.grid_p, self.dt, s.clock, V(*model.gravity), T(tc.gravity_ramp),
-                    T(tc.damping), T(tc.damping_until if tc.damping > 0 else 0.0), T(model.mass_threshold), origin, dx, model.walls_device, self.wall_impulse, self.vmax],
+                    T(tc.damping), T(tc.damping_until if tc.damping > 0 else 0.0), T(model.mass_threshold),
+                    origin, dx, model.walls_device, self.wall_impulse, self.vmax],
             device=dev, record_cmd=True)
         self._g2p = wp.launch(
             g2p_kernel(T), model.n_particles,
