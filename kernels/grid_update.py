@@ -71,10 +71,13 @@ def wall_motion_func(T):
 
 @functools.cache
 def grid_update_kernel(T, has_walls: bool):
-    """Build the grid update kernel (launched over all nodes).
+    """Build the grid update kernel (launched over all nodes, or a slab of them).
 
-    ``grid_p`` holds nodal momentum (kg m/s) on entry and velocity (m/s) on
-    exit. ``vmax[0]`` receives the largest nodal speed (m/s), used by the
+    ``grid_m`` / ``grid_p`` have a leading axis of grid copies: on the CPU each
+    thread scatters into its own copy and this kernel sums them (one copy on
+    CUDA). ``grid_p[0]`` holds the summed nodal momentum (kg m/s) on entry
+    and the velocity (m/s) on exit. The launch covers nodes ``i0 + tid``
+    along x. ``vmax[0]`` receives the largest nodal speed (m/s), used by the
     automatic time step of the next step.
     """
     V = vec3(T)
@@ -83,8 +86,9 @@ def grid_update_kernel(T, has_walls: bool):
 
     @wp.kernel(enable_backward=False)
     def grid_update(
-        grid_m: wp.array3d(dtype=T),
-        grid_p: wp.array3d(dtype=V),
+        grid_m: wp.array4d(dtype=T),
+        grid_p: wp.array4d(dtype=V),
+        i0: int,
         dt_arr: wp.array(dtype=T),
         clock: wp.array(dtype=wp.float64),
         gravity: V,
@@ -98,19 +102,24 @@ def grid_update_kernel(T, has_walls: bool):
         wall_impulse: wp.array(dtype=V),
         vmax: wp.array(dtype=T),
     ):
-        i, j, k = wp.tid()
+        ii, j, k = wp.tid()
+        i = ii + i0
         dt = dt_arr[0]
         if dt <= T(0.0):
             return
-        m = grid_m[i, j, k]
+        m = grid_m[0, i, j, k]
+        mom = grid_p[0, i, j, k]
+        for c in range(1, grid_m.shape[0]):
+            m += grid_m[c, i, j, k]
+            mom += grid_p[c, i, j, k]
         if m <= mass_threshold:
-            grid_p[i, j, k] = V(T(0.0), T(0.0), T(0.0))
+            grid_p[0, i, j, k] = V(T(0.0), T(0.0), T(0.0))
             return
         t = T(clock[0])
         g_scale = T(1.0)
         if gravity_ramp > T(0.0):
             g_scale = wp.min(t / gravity_ramp, T(1.0))
-        vel = grid_p[i, j, k] / m + (dt * g_scale) * gravity
+        vel = mom / m + (dt * g_scale) * gravity
         if t < damping_until:
             vel = vel * wp.max(T(1.0) - damping * dt, T(0.0))
         if wp.static(has_walls):
@@ -136,7 +145,7 @@ def grid_update_kernel(T, has_walls: bool):
                             vrel = vt * (T(1.0) + wall.friction * vn / vt_norm)
                     vel = vw + vrel
                     wp.atomic_add(wall_impulse, w, m * (v_old - vel))
-        grid_p[i, j, k] = vel
+        grid_p[0, i, j, k] = vel
         wp.atomic_max(vmax, 0, wp.length(vel))
 
     return grid_update

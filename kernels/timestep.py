@@ -36,9 +36,12 @@ def begin_step_kernel(T):
         dt_max: wp.float64,
         dt_arr: wp.array(dtype=T),
     ):
+        vm = vmax[0]
+        for k in range(1, vmax.shape[0]):
+            vm = wp.max(vm, vmax[k])
         d = dt_fixed
         if d <= wp.float64(0.0):
-            d = cfl * dx / (c_p + wp.float64(vmax[0]))
+            d = cfl * dx / (c_p + wp.float64(vm))
         d = wp.min(d, dt_max)
         rem = clock[2] - clock[0]
         if rem <= wp.float64(1.0e-9) * d:
@@ -47,7 +50,8 @@ def begin_step_kernel(T):
             d = rem
         clock[1] = d
         dt_arr[0] = T(d)
-        vmax[0] = T(0.0)
+        for k in range(vmax.shape[0]):
+            vmax[k] = T(0.0)
 
     return begin_step
 

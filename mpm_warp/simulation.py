@@ -90,6 +90,10 @@ class Simulation:
         ``"cpu"``, ``"cuda"``, ``"cuda:N"`` or None (``MPM_WARP_DEVICE``, then CUDA if present).
     use_graph : bool or None
         CUDA graph capture of step batches (default on CUDA).
+    n_threads : int or None
+        CPU threads for the step (default: all cores for scenes of 20k particles
+        or more; ``MPM_WARP_THREADS`` overrides). Results depend on the thread
+        count at round-off level only (the order grid copies are summed in).
 
     Examples
     --------
@@ -97,13 +101,14 @@ class Simulation:
     >>> result = sim.run("out.h5")                                # doctest: +SKIP
     """
 
-    def __init__(self, scenario: Scenario, device: str | None = None, use_graph: bool | None = None):
+    def __init__(self, scenario: Scenario, device: str | None = None, use_graph: bool | None = None,
+                 n_threads: int | None = None):
         self.scenario = scenario.validate()
         self.device = resolve_device(device)
         self.model = Model(self.scenario, self.device)
         fields_ = self.scenario.output.fields
         self.state: State = self.model.initial_state(track_yield="yielded" in fields_)
-        self.stepper = Stepper(self.model, self.state, use_graph)
+        self.stepper = Stepper(self.model, self.state, use_graph, n_threads)
         self.frame_index = 0
         self.x0 = self.state.x.numpy().astype(np.float64)
         #: functions ``f(sim) -> dict[str, float]`` evaluated at every frame and stored as scalar series
@@ -261,7 +266,7 @@ class Simulation:
         steps_total = 0
         frames = 0
         wall = 0.0
-        edge0 = int(self.stepper.edge_count.numpy()[0])
+        edge0 = self.stepper.edge_count()[0]
         try:
             while self.frame_index < n_frames_total:
                 t_next = min((self.frame_index + 1) * fi, end)
@@ -288,14 +293,12 @@ class Simulation:
                 writer.close()
         n = self.model.n_particles
         return RunResult(output, steps_total, frames, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
-                         n, self.device, int(self.stepper.edge_count.numpy()[0]) - edge0)
+                         n, self.device, self.stepper.edge_count()[0] - edge0)
 
     def _compile(self) -> None:
         """Load every kernel of the plan (compiling on first use) without stepping."""
-        for m in {wp.get_module(k.kernel.module.name) for k in [self.stepper._begin, *self.stepper._p2g,
-                                                                  self.stepper._grid, self.stepper._g2p,
-                                                                  self.stepper._end]}:
-            m.load(self.device)
+        for m in {k.kernel.module for k in self.stepper.launches}:
+            m.load(wp.get_device(self.device))
 
     # ----------------------------------------------------------------- output
     def _open_writer(self, path: str) -> io.RunWriter:

@@ -9,6 +9,9 @@ steps is captured once as a graph and replayed.
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import warp as wp
 
@@ -19,11 +22,33 @@ from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec3
 from .model import SINGULAR_VALUE_FLOOR, Model, State
 
-__all__ = ["Stepper"]
+__all__ = ["Stepper", "default_threads"]
+
+
+def default_threads(device: str, n_particles: int) -> int:
+    """CPU threads for the step: all cores for large scenes, 1 on CUDA or below 20k particles."""
+    if wp.get_device(device).is_cuda or n_particles < 20000:
+        return 1
+    env = os.environ.get("MPM_WARP_THREADS")
+    if env:
+        return max(1, int(env))
+    return max(1, min(os.cpu_count() or 1, 64))
+
+
+def _chunks(start: int, end: int, n: int) -> list[tuple[int, int]]:
+    """Split ``[start, end)`` into ``n`` contiguous near-equal ranges."""
+    edges = np.linspace(start, end, n + 1).round().astype(int)
+    return [(int(edges[k]), int(edges[k + 1])) for k in range(n)]
 
 
 class Stepper:
     """Launch plan for one model and state.
+
+    On the CPU a Warp launch runs on one thread, so the step is split over
+    ``n_threads`` Python threads (a launch releases the GIL): each thread
+    scatters its share of the particles into its own grid copy, the grid update
+    sums the copies slab by slab, and G2P gathers particle ranges. Atomics
+    never cross threads. On CUDA there is one grid copy and one launch per stage.
 
     Parameters
     ----------
@@ -31,22 +56,32 @@ class Stepper:
     state : State
     use_graph : bool or None
         Capture a batch of steps as a CUDA graph (default: on CUDA only).
+    n_threads : int or None
+        CPU threads (default :func:`default_threads`; ``MPM_WARP_THREADS`` overrides).
     """
 
-    def __init__(self, model: Model, state: State, use_graph: bool | None = None):
+    def __init__(self, model: Model, state: State, use_graph: bool | None = None, n_threads: int | None = None):
         self.model = model
         self.state = state
         T = model.T
         dev = model.device
         V = vec3(T)
-        self.grid_m = wp.zeros(model.grid_shape, dtype=T, device=dev)
-        self.grid_p = wp.zeros(model.grid_shape, dtype=V, device=dev)
+        nt = n_threads or default_threads(dev, model.n_particles)
+        nt = max(1, min(nt, model.grid_shape[0] // 3, max(1, model.n_particles // 1000)))
+        self.n_threads = nt
+        gs = model.grid_shape
+        self.grid_m_all = wp.zeros((nt, *gs), dtype=T, device=dev)
+        self.grid_p_all = wp.zeros((nt, *gs), dtype=V, device=dev)
+        #: summed nodal mass (kg) and, after the grid update, nodal velocity (m/s)
+        self.grid_m = self.grid_m_all[0]
+        self.grid_p = self.grid_p_all[0]
         self.dt = wp.zeros(1, dtype=T, device=dev)
-        self.vmax = wp.zeros(1, dtype=T, device=dev)
-        # [particles clamped at the grid edge, particles skipped with a stencil outside the grid]
-        self.edge_count = wp.zeros(2, dtype=wp.int32, device=dev)
+        self.vmax = wp.zeros(nt, dtype=T, device=dev)
+        # per thread: [particles clamped at the grid edge, particles skipped with a stencil outside the grid]
+        self.edge_counts = wp.zeros((nt, 2), dtype=wp.int32, device=dev)
         has_walls = bool(model.walls)
-        self.wall_impulse = wp.zeros(len(model.walls), dtype=V, device=dev) if has_walls else None
+        nw = max(len(model.walls), 1)
+        self.wall_impulses = wp.zeros((nt, nw), dtype=V, device=dev) if has_walls else None
         self.fixed_dt = model.scenario.time.dt
         tc = model.scenario.time
         dt_max = tc.dt_max if tc.dt_max > 0 else 1e30
@@ -58,55 +93,83 @@ class Stepper:
         self._begin = wp.launch(begin_step_kernel(T), 1, inputs=[s.clock, self.vmax, tc.cfl, model.dx, model.c_p,
                                                                  self.fixed_dt, dt_max, self.dt],
                                 device=dev, record_cmd=True)
-        self._p2g = []
+        # per thread k: P2G launches, grid-update slab, G2P range
+        self._p2g: list[list] = [[] for _ in range(nt)]
         for g in model.groups:
             mat = g.material
             plastic = mat.plastic
-            sl = slice(g.start, g.end)
             if plastic:
-                psl = slice(g.plastic_start, g.plastic_start + g.count)
-                ljp = s.log_jp[psl]
-                yld = s.yielded[psl] if s.yielded is not None else None
                 cc = (T(mat.M), T(mat.beta), T(mat.xi), T(mat.p0_floor))
             else:
-                ljp, yld = None, None
                 cc = (T(0.0), T(0.0), T(0.0), T(0.0))
-            k = p2g_kernel(T, plastic, plastic and yld is not None)
-            self._p2g.append(wp.launch(
-                k, g.count,
-                inputs=[s.x[sl], s.v[sl], s.C[sl], s.F[sl], ljp, yld, T(g.mass), T(g.vol0), T(mat.mu), T(mat.lam),
-                        *cc, T(SINGULAR_VALUE_FLOOR), self.dt, origin, inv_dx, dx, self.grid_m, self.grid_p,
-                        self.edge_count[1:]],
+            k_p2g = p2g_kernel(T, plastic, plastic and s.yielded is not None)
+            for k, (a, b) in enumerate(_chunks(g.start, g.end, nt)):
+                if b <= a:
+                    continue
+                sl = slice(a, b)
+                if plastic:
+                    psl = slice(g.plastic_start + a - g.start, g.plastic_start + b - g.start)
+                    ljp = s.log_jp[psl]
+                    yld = s.yielded[psl] if s.yielded is not None else None
+                else:
+                    ljp, yld = None, None
+                self._p2g[k].append(wp.launch(
+                    k_p2g, b - a,
+                    inputs=[s.x[sl], s.v[sl], s.C[sl], s.F[sl], ljp, yld, T(g.mass), T(g.vol0), T(mat.mu),
+                            T(mat.lam), *cc, T(SINGULAR_VALUE_FLOOR), self.dt, origin, inv_dx, dx,
+                            self.grid_m_all[k], self.grid_p_all[k], self.edge_counts[k][1:]],
+                    device=dev, record_cmd=True))
+        self._grid = []
+        for k, (a, b) in enumerate(_chunks(0, gs[0], nt)):
+            self._grid.append(wp.launch(
+                grid_update_kernel(T, has_walls), (b - a, gs[1], gs[2]),
+                inputs=[self.grid_m_all, self.grid_p_all, a, self.dt, s.clock, V(*model.gravity),
+                        T(tc.gravity_ramp), T(tc.damping), T(tc.damping_until if tc.damping > 0 else 0.0),
+                        T(model.mass_threshold), origin, dx, model.walls_device,
+                        self.wall_impulses[k] if has_walls else None, self.vmax[k:k + 1]],
                 device=dev, record_cmd=True))
-        self._grid = wp.launch(
-            grid_update_kernel(T, has_walls), model.grid_shape,
-            inputs=[self.grid_m, self.grid_p, self.dt, s.clock, V(*model.gravity), T(tc.gravity_ramp),
-                    T(tc.damping), T(tc.damping_until if tc.damping > 0 else 0.0), T(model.mass_threshold),
-                    origin, dx, model.walls_device, self.wall_impulse, self.vmax],
-            device=dev, record_cmd=True)
-        self._g2p = wp.launch(
-            g2p_kernel(T), model.n_particles,
-            inputs=[s.x, s.v, s.C, self.grid_p, self.dt, origin, inv_dx, dx, V(*model.x_lo), V(*model.x_hi),
-                    self.edge_count],
-            device=dev, record_cmd=True)
+        self._g2p = []
+        for k, (a, b) in enumerate(_chunks(0, model.n_particles, nt)):
+            sl = slice(a, b)
+            self._g2p.append(wp.launch(
+                g2p_kernel(T), b - a,
+                inputs=[s.x[sl], s.v[sl], s.C[sl], self.grid_p, self.dt, origin, inv_dx, dx, V(*model.x_lo),
+                        V(*model.x_hi), self.edge_counts[k]],
+                device=dev, record_cmd=True))
         self._end = wp.launch(end_step_kernel(), 1, inputs=[s.clock, s.steps], device=dev, record_cmd=True)
         self.use_graph = wp.get_device(dev).is_cuda if use_graph is None else use_graph
         self._graphs: dict[int, object] = {}
+        self._pool = ThreadPoolExecutor(nt, thread_name_prefix="mpm_warp") if nt > 1 else None
         #: recorded launches (``.launch()``) run at the start of every step, after the step size is set
         #: (e.g. a saw advancing through a weak layer); add them before the first call of :meth:`steps`.
         self.actions: list = []
 
+    @property
+    def launches(self) -> list:
+        """Every recorded launch of the plan (for compiling ahead of timing)."""
+        return [self._begin, *[k for ks in self._p2g for k in ks], *self._grid, *self._g2p, self._end,
+                *self.actions]
+
     # ------------------------------------------------------------------ steps
+    def _scatter(self, k: int) -> None:
+        self.grid_m_all[k].zero_()
+        self.grid_p_all[k].zero_()
+        for launch in self._p2g[k]:
+            launch.launch()
+
     def _launch_step(self) -> None:
         self._begin.launch()
         for a in self.actions:
             a.launch()
-        self.grid_m.zero_()
-        self.grid_p.zero_()
-        for k in self._p2g:
-            k.launch()
-        self._grid.launch()
-        self._g2p.launch()
+        if self._pool is None:
+            self._scatter(0)
+            self._grid[0].launch()
+            self._g2p[0].launch()
+        else:
+            n = self.n_threads
+            list(self._pool.map(self._scatter, range(n)))
+            list(self._pool.map(lambda k: self._grid[k].launch(), range(n)))
+            list(self._pool.map(lambda k: self._g2p[k].launch(), range(n)))
         self._end.launch()
 
     def steps(self, n: int) -> None:
@@ -145,8 +208,13 @@ class Stepper:
 
         Divided by the elapsed time it is the mean force on the wall (N).
         """
-        if self.wall_impulse is None:
+        if self.wall_impulses is None:
             return np.zeros((0, 3))
-        imp = self.wall_impulse.numpy().astype(np.float64)
-        self.wall_impulse.zero_()
+        imp = self.wall_impulses.numpy().astype(np.float64).sum(axis=0)
+        self.wall_impulses.zero_()
         return imp
+
+    def edge_count(self) -> tuple[int, int]:
+        """(particles clamped at the grid edge, particles skipped outside the grid) so far."""
+        e = self.edge_counts.numpy().sum(axis=0)
+        return int(e[0]), int(e[1])
