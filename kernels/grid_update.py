@@ -1,8 +1,8 @@
 """Grid update: nodal momentum to velocity, gravity, walls (MODEL.md 5).
 
 Walls are planes ``(point, normal)`` with the normal pointing into the
-material. A node with signed distance ``phi = (x_i - p(t)) . n <= 0`` lies in
-the wall and its velocity relative to the wall is constrained:
+material. A node with signed distance ``phi = (x_i - p(t)) . n <= 1e-3 dx``
+lies in the wall and its velocity relative to the wall is constrained:
 
 - ``STICKY``: relative velocity set to zero;
 - ``SLIP``: normal component removed, tangential kept (frictionless, bonded);
@@ -128,7 +128,8 @@ def grid_update_kernel(T, has_walls: bool):
                 wall = walls[w]
                 pw, vw = motion(wall, t + dt)
                 n = wall.normal
-                if wp.dot(xn - pw, n) <= T(0.0):
+                # nodes on the plane belong to the wall; the 1e-3 dx margin absorbs the rounding of origin + i dx
+                if wp.dot(xn - pw, n) <= T(1.0e-3) * dx:
                     v_old = vel
                     vrel = vel - vw
                     vn = wp.dot(vrel, n)

@@ -253,7 +253,7 @@ class Simulation:
         fi = tc.frame_interval if frame_interval is None else frame_interval
         writer = None
         ckpt = io.checkpoint_path_for(output) if output else None
-        n_frames_total = int(round(end / fi))
+        n_frames_total = int(math.ceil(end / fi - 1e-9))
         if output:
             if append:
                 writer = io.RunWriter.reopen(output, keep_frames=self.frame_index + 1)
@@ -261,6 +261,7 @@ class Simulation:
                 writer = self._open_writer(output)
                 self._write_frame(writer)
                 self._checkpoint(ckpt)
+        self._last_frame_time = self.time
         # warm up: compile every kernel before timing
         self._compile()
         steps_total = 0
@@ -335,8 +336,10 @@ class Simulation:
         for f in self.frame_diagnostics:
             scalars.update(f(self))
         imp = self.stepper.take_wall_impulse()
-        span = self.scenario.time.frame_interval
-        forces = imp / span if len(imp) else None
+        # mean force over the frame just ended (its real duration: the last frame may be short)
+        span = t - getattr(self, "_last_frame_time", t)
+        self._last_frame_time = t
+        forces = (imp / span if span > 0 else np.zeros_like(imp)) if len(imp) else None
         writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
 
     def _checkpoint(self, path: str | None) -> None:
