@@ -113,7 +113,12 @@ class Simulation:
         self.x0 = self.state.x.numpy().astype(np.float64)
         #: functions ``f(sim) -> dict[str, float]`` evaluated at every frame and stored as scalar series
         self.frame_diagnostics: list[Callable[[Simulation], dict]] = []
+        #: functions ``f(sim) -> dict`` evaluated when a run ends, merged into ``RunResult.extra``
+        self.result_hooks: list[Callable[[Simulation], dict]] = []
         self._bad = wp.full(3, INT_MAX, dtype=wp.int32, device=self.device)
+        from .scenes import attach_scene
+
+        attach_scene(self)
         self._energy = wp.zeros(2, dtype=wp.float64, device=self.device)
 
     # ----------------------------------------------------------------- public
@@ -293,8 +298,11 @@ class Simulation:
             if writer is not None:
                 writer.close()
         n = self.model.n_particles
+        extra = {}
+        for hook in self.result_hooks:
+            extra.update(hook(self))
         return RunResult(output, steps_total, frames, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
-                         n, self.device, self.stepper.edge_count()[0] - edge0)
+                         n, self.device, self.stepper.edge_count()[0] - edge0, extra)
 
     def _compile(self) -> None:
         """Load every kernel of the plan (compiling on first use) without stepping."""
