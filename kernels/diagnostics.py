@@ -113,7 +113,8 @@ def health_kernel(T):
             return
         if wp.length(vi) * T(clock[1]) > max_cells * dx:
             wp.atomic_min(bad, 1, i)
-        if wp.determinant(Fi) <= T(0.0):
+        # float64: a floored F (singular values down to 1e-6) has det ~ 1e-12, below float32 rounding
+        if wp.determinant(wp.mat33d(Fi)) <= wp.float64(0.0):
             wp.atomic_min(bad, 2, i)
 
     return health

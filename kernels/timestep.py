@@ -50,8 +50,9 @@ def begin_step_kernel(T):
             d = rem
         clock[1] = d
         dt_arr[0] = T(d)
-        for k in range(vmax.shape[0]):
-            vmax[k] = T(0.0)
+        if d > wp.float64(0.0):  # a no-op step (frame end reached) keeps the speed bound for the next frame
+            for k in range(vmax.shape[0]):
+                vmax[k] = T(0.0)
 
     return begin_step
 

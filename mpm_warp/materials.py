@@ -132,17 +132,21 @@ MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow}
 
 def material_from_dict(d: dict, where: str = "material") -> Elastic:
     """Build a material from a dict with a ``model`` key; unknown keys are errors."""
+    import difflib
+
     from .errors import ScenarioError
 
     d = dict(d)
     model = d.pop("model", "elastic")
-    if model not in MATERIAL_MODELS:
+    if not isinstance(model, str) or model not in MATERIAL_MODELS:
         raise ScenarioError(f"{where}.model = {model!r} is unknown: expected one of {sorted(MATERIAL_MODELS)}")
     cls = MATERIAL_MODELS[model]
     names = [f for f in cls.__dataclass_fields__ if f != "model"]
     for k in d:
         if k not in names:
-            raise ScenarioError(f"{where}.{k}: unknown key for model {model!r}; allowed: {', '.join(names)}")
+            close = difflib.get_close_matches(k, names, n=1)
+            hint = f" (did you mean '{where}.{close[0]}'?)" if close else ""
+            raise ScenarioError(f"unknown key '{where}.{k}'{hint} for model {model!r}; allowed: {', '.join(names)}")
     for k in ("E", "nu", "density"):
         if k not in d:
             raise ScenarioError(f"{where}.{k}: missing (required for model {model!r})")

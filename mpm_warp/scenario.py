@@ -186,7 +186,7 @@ class Scenario:
                                   f"a spacing giving at most 4096 cells per axis (got {max(ncell):.0f})")
         choice("domain.boundary", d.boundary, (*WALL_KINDS, "none"))
         finite_number("domain.friction", d.friction, lo=0.0)
-        if not set(d.boundary_faces) <= set("xyz"):
+        if not isinstance(d.boundary_faces, str) or not set(d.boundary_faces) <= set("xyz"):
             raise InvalidArgument("domain.boundary_faces", d.boundary_faces, "letters among 'xyz'")
         dom = Domain(lo, hi, dx, d.boundary, float(d.friction), d.boundary_faces)
 
@@ -235,6 +235,8 @@ class Scenario:
 
         walls = tuple(w.validate(f"walls[{i}]") for i, w in enumerate(self.walls))
         out = self.output
+        if not isinstance(out.fields, (list, tuple)):
+            raise InvalidArgument("output.fields", out.fields, "a list of field names, e.g. [\"x\", \"v\"]")
         for f_ in out.fields:
             choice("output.fields[]", f_, tuple(OUTPUT_FIELDS))
         positive_int("output.checkpoint_every", out.checkpoint_every, lo=0)
@@ -350,14 +352,21 @@ def apply_overrides(raw: dict, overrides: list[str] | dict) -> dict:
                 try:
                     node = node[int(p)]
                 except (ValueError, IndexError):
-                    raise ScenarioError(f"override {key!r}: no element {p!r}") from None
-            else:
+                    raise ScenarioError(f"override {key!r}: no element {p!r} (the list has {len(node)})") from None
+            elif isinstance(node, dict):
                 node = node.setdefault(p, {})
+            else:
+                raise ScenarioError(f"override {key!r}: {p!r} is below a value ({node!r}), not a table")
         last = parts[-1]
         if isinstance(node, list):
-            node[int(last)] = value
-        else:
+            try:
+                node[int(last)] = value
+            except (ValueError, IndexError):
+                raise ScenarioError(f"override {key!r}: no element {last!r} (the list has {len(node)})") from None
+        elif isinstance(node, dict):
             node[last] = value
+        else:
+            raise ScenarioError(f"override {key!r}: {last!r} is below a value ({node!r}), not a table")
     return raw
 
 

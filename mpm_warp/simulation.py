@@ -115,6 +115,7 @@ class Simulation:
         self.frame_diagnostics: list[Callable[[Simulation], dict]] = []
         #: functions ``f(sim) -> dict`` evaluated when a run ends, merged into ``RunResult.extra``
         self.result_hooks: list[Callable[[Simulation], dict]] = []
+        self._since_health = 0
         self._bad = wp.full(3, INT_MAX, dtype=wp.int32, device=self.device)
         from .scenes import attach_scene
 
@@ -211,7 +212,6 @@ class Simulation:
         self.stepper.set_frame_end(t_end)
         t, dt, steps0 = self.stepper.clock()
         taken = 0
-        since_health = 0
         while t < t_end * (1 - 1e-12) - 1e-15:
             if dt <= 0:
                 dt = self._first_dt()
@@ -219,10 +219,10 @@ class Simulation:
             self.stepper.steps(n)
             t, dt_new, steps = self.stepper.clock()
             taken = steps - steps0
-            since_health += n
-            if since_health >= he:
+            self._since_health += n
+            if self._since_health >= he:
                 self.health()
-                since_health = 0
+                self._since_health = 0
             dt = dt_new if dt_new > 0 else dt
         return taken
 
@@ -282,6 +282,8 @@ class Simulation:
                 wall += _time.perf_counter() - t0
                 self.frame_index += 1
                 frames += 1
+                self.health()  # never write a bad state into a frame or a checkpoint
+                self._since_health = 0
                 if writer is not None:
                     self._write_frame(writer)
                     ce = self.scenario.output.checkpoint_every
@@ -354,7 +356,9 @@ class Simulation:
         if path is None:
             return
         meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device}
-        io.write_checkpoint(path, self.state.arrays(), meta)
+        arrays = self.state.arrays()
+        arrays["vmax"] = self.stepper.vmax.numpy()  # the next step's speed bound, so resume is bit for bit
+        io.write_checkpoint(path, arrays, meta)
 
 
 def resume(output: str, device: str | None = None, end_time: float | None = None,
@@ -368,6 +372,10 @@ def resume(output: str, device: str | None = None, end_time: float | None = None
     sc = Scenario.from_dict(meta["scenario"], source=output)
     sim = Simulation(sc, device=device)
     sim.state.load_arrays(arrays)
+    if "vmax" in arrays:
+        sim.stepper.vmax.assign(arrays["vmax"])
+    else:
+        sim.stepper.seed_vmax()
     sim.frame_index = int(meta["frame_index"])
     run = io.read_run(output)
     sim.x0 = run.static["x0"].astype(np.float64)

@@ -77,6 +77,7 @@ class Stepper:
         self.grid_p = self.grid_p_all[0]
         self.dt = wp.zeros(1, dtype=T, device=dev)
         self.vmax = wp.zeros(nt, dtype=T, device=dev)
+        self.seed_vmax()
         # per thread: [particles clamped at the grid edge, particles skipped with a stencil outside the grid]
         self.edge_counts = wp.zeros((nt, 2), dtype=wp.int32, device=dev)
         has_walls = bool(model.walls)
@@ -191,6 +192,17 @@ class Stepper:
         else:
             for _ in range(n):
                 self._launch_step()
+
+    def seed_vmax(self) -> None:
+        """Set the speed bound of the next step from the particles' current speeds.
+
+        The step size uses the largest nodal speed of the previous step; before
+        the first step (or after loading a state) there is none, so the particle
+        speeds stand in for it and a fast initial state gets a small first step.
+        """
+        v = self.state.v.numpy()
+        vm = float(np.sqrt((v.astype(np.float64) ** 2).sum(axis=1)).max(initial=0.0))
+        self.vmax.fill_(vm)
 
     def set_frame_end(self, t_end: float) -> None:
         """Set the time the coming steps must land on (s)."""
