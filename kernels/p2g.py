@@ -105,9 +105,11 @@ def p2g_kernel(T, plastic: bool, track_yield: bool):
             Vt = M()
             wp.svd3(F_tr, U, s, Vt)
             s_new = clamp_sv(s, s_floor)
-            changed = 0
+            changed = int(0)
+            floored = int(0)
             if s_new[2] != s[2]:
                 changed = 1
+                floored = 1
             if wp.static(plastic):
                 s_ret, ljp, y = camclay(s_new, log_jp[i], mu, lam, M_csl, beta, xi, p0_floor)
                 s_new = s_ret
@@ -116,8 +118,13 @@ def p2g_kernel(T, plastic: bool, track_yield: bool):
                 if wp.static(track_yield):
                     if y != 0:
                         yielded[i] = wp.uint8(1)
-            if changed != 0:
+            if floored != 0:
                 F[i] = U * wp.diag(s_new) * wp.transpose(Vt)
+            elif changed != 0:
+                # U diag(s_new) V^T written as a correction of F_tr: rebuilding from the float32 SVD factors
+                # puts round-off back outside the yield surface and ratchets a settled layer (creep)
+                r = V((s_new[0] - s[0]) / s[0], (s_new[1] - s[1]) / s[1], (s_new[2] - s[2]) / s[2])
+                F[i] = F_tr + F_tr * (Vt * wp.diag(r) * wp.transpose(Vt))
             else:
                 F[i] = F_tr
             tau_p = hencky(s_new, mu, lam, s_floor)

@@ -1,0 +1,443 @@
+"""Weak-layer collapse under a slab against the hardening rule (VALIDATION.md "Snow"; SI Note 3).
+
+Set-up (:func:`weak_layer_column`)
+----------------------------------
+A quasi-1D column one cell square between frictionless (slip) side walls on a
+sticky floor ``y = 0``: a Cam-Clay weak layer of thickness ``D_wl`` under an
+elastic slab of thickness ``h`` and density ``rho_s``, loaded by gravity
+ramped from 0 over ``ramp`` seconds. The slab weight is the load; ``p0`` is
+varied through the slab density, as in the paper. The layer is laterally
+confined: the loading is uniaxial strain (oedometric), not isotropic.
+
+Closed form for this loading (derived here, MODEL.md 2-3)
+---------------------------------------------------------
+Under uniaxial strain with ``xi`` small the state leaves the elastic line
+``q/p = 2 mu/K`` and settles on the cap at the point where the flow direction
+``(dy/dp, dy/dq)`` is parallel to the imposed strain ``(eps_v, eps_q) = (1, 2/3)``:
+that is the point of the ellipse where the axial stress ``tau_v = p + 2 q/3``
+is largest (normality). Hence, on the cap,
+
+    tau_v = lambda_oed p0,
+    lambda_oed = [(1 - beta) + (1 + beta) sqrt(1 + 4 M^2 / (9 (1 + 2 beta)))] / 2
+
+(1.0848 for M = 1, beta = 0.3: p0 = 0.922 tau_v, q/p = 0.259 instead of 0 in
+isotropic compression). Because ``tau_v`` is stationary there, the O(xi) shift of
+the state along the ellipse (elastic strains) changes ``p0 / tau_v`` only at
+second order: the engine's own return under uniaxial strain
+(:func:`oedometric_state`, float64) gives 0.92192, 0.92195, 0.92244 for
+xi = 0.01, 0.04, 0.16 against 1/lambda_oed = 0.92187.
+
+The yield surface is in Kirchhoff stress, ``tau = J sigma`` with the total
+``J = J_E J_P`` (relative to the start), while the slab weight fixes the
+Cauchy stress: ``sigma_v = W`` (weight per area above the point; the area is
+fixed by the side walls). So ``tau_v = J W`` and the hardening rule (MODEL.md 3)
+gives the collapse implicitly:
+
+    1 - J_P = 1 - exp(-(asinh(p0 / K) - asinh(p0_ini / K)) / xi),
+    p0 = J_E J_P W / lambda_oed,   J_E = exp(-p/K)
+
+(:func:`oedometric_collapse`, solved by bisection). Dropping ``J`` (using the
+Cauchy load) over-predicts the collapse by about the collapse itself (+10 % at
+1 - J_P = 0.09, +37 % at 0.32); the isotropic formula of MODEL.md 6 with
+``p = W`` (``lambda_oed = 1``, ``q = 0``, no ``J``) by +19 % and +45 %.
+
+What each particle can assert exactly: ``log_Jp`` fixes ``p0`` through the
+hardening rule, and a particle that yielded in its last step lies on the
+ellipse of that ``p0``, so ``p0 = p0_ellipse(p, q)``
+(:func:`consolidation_pressure`, any q), not ``p0 = p`` (only when q = 0).
+After the load stops the state may sit inside (unloading is elastic), so
+``p0_ellipse(p, q) <= K sinh(-xi log_Jp)`` always holds and equality holds up to
+the explicit-hardening lag of one step.
+
+Explicit hardening: ``p0`` comes from the previous ``log_Jp``, so the
+collapse converges at first order in the number of plastic increments
+(material-point driver: relative error 1.0e-2, 1.0e-3, 1.4e-4 after 1e2, 1e3,
+1e4 increments); the column compacts over ~1e3 steps (2 cells across the
+layer) to ~3e4 (32 cells), so this error is 1e-3 to 3e-5 here.
+
+Findings (CPU; details in the tests and ``benchmarks/mesh_study.py``)
+--------------------------------------------------------------------
+* Interface cell: the layer under-compacts within about half a cell of the
+  slab (one velocity field across a stiff/soft interface; the top particle
+  row reaches ~0.3 of the closed form), the layer interior slightly over-
+  compacts. Whole-layer 1 - J_P error: -18..-27 % at 2 cells across the layer,
+  -5..-13 % at 4, -1.3..-5.7 % at 8, -0.3..-2.1 % at 16, -0.05..-0.5 % at 32;
+  the interior converges to the closed form (|error| <= 0.2 % at 32 cells).
+* float32 creep (engine issue, :func:`test_settled_layer_does_not_creep`): in
+  float32 about 60 % of the settled layer's particles go through the Cam-Clay
+  return every step (-log_Jp grows ~2.7e-7 each), float64: none. P2G rebuilds
+  ``F_E = U diag(s_new) V^T`` from the float32 SVD whenever the return is
+  active; the SVD round-off (worst for the two equal lateral singular values of
+  a confined layer) puts the state back outside the ellipse the next step, so
+  it ratchets. Applying the correction to the trial gradient instead,
+  ``F_E = F_tr + F_tr V diag((s_new - s)/s) V^T`` (equal in exact arithmetic),
+  removed it in a scratch copy of the engine: no returns while settled, the
+  float32 collapse equal to float64 within 5e-6 (the float32 case below then
+  passes; the slab tests still pass).
+
+Measured (CPU, float32 unless noted) and tolerances: see the constants below.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import mpm_warp as mw
+from mpm_warp.material_point import drive_material_points
+
+DEVICE = "cpu"
+G = 9.81
+
+
+# --------------------------------------------------------------- theory
+def oedometric_ratio(M: float, beta: float) -> float:
+    """``lambda_oed = max tau_v / p0`` on the yield ellipse (uniaxial strain, xi -> 0); dimensionless.
+
+    The ellipse has centre ``p0 (1 - beta)/2``, semi-axes ``a = p0 (1 + beta)/2``
+    in p and ``M a / sqrt(1 + 2 beta)`` in q; the largest ``p + 2 q / 3`` on it is
+    ``p0 [(1 - beta) + (1 + beta) sqrt(1 + 4 M^2 / (9 (1 + 2 beta)))] / 2``.
+    """
+    return 0.5 * ((1.0 - beta) + (1.0 + beta) * math.sqrt(1.0 + 4.0 * M * M / (9.0 * (1.0 + 2.0 * beta))))
+
+
+def oedometric_point(M: float, beta: float) -> tuple[float, float]:
+    """``(p / p0, q / p0)`` of the uniaxial-strain state on the ellipse (xi -> 0)."""
+    a = 0.5 * (1.0 + beta)
+    b = M * a / math.sqrt(1.0 + 2.0 * beta)
+    s = math.sqrt(a * a + (2.0 / 3.0) ** 2 * b * b)
+    return 0.5 * (1.0 - beta) + a * a / s, (2.0 / 3.0) * b * b / s
+
+
+def consolidation_pressure(p, q, M: float, beta: float):
+    """``p0`` (Pa) of the yield ellipse through the Kirchhoff state ``(p, q)`` (Pa).
+
+    The positive root of ``beta M^2 p0^2 + (1 - beta) M^2 p p0 - M^2 p^2 - (1 + 2 beta) q^2 = 0``;
+    equals ``p`` when ``q = 0``.
+    """
+    p = np.asarray(p, dtype=np.float64)
+    q = np.asarray(q, dtype=np.float64)
+    b = (1.0 - beta) * p
+    c = p * p + (1.0 + 2.0 * beta) * q * q / (M * M)
+    if beta == 0.0:
+        return c / b
+    return (-b + np.sqrt(b * b + 4.0 * beta * c)) / (2.0 * beta)
+
+
+def hardening_collapse(p0, p0_ini: float, K: float, xi: float):
+    """``1 - J_P / J_P(0) = 1 - exp(-(asinh(p0/K) - asinh(p0_ini/K)) / xi)`` (MODEL.md 3, 6)."""
+    return 1.0 - np.exp(-(np.arcsinh(np.asarray(p0, dtype=np.float64) / K) - math.asinh(p0_ini / K)) / xi)
+
+
+def oedometric_collapse(W, mat: mw.CamClaySnow) -> np.ndarray:
+    """Closed-form collapse ``1 - J_P`` of a laterally confined layer under the Cauchy load ``W`` (Pa).
+
+    Solves ``c = hardening_collapse(p0)`` with ``p0 = J_E (1 - c) W / lambda_oed``,
+    ``J_E = exp(-p/K)``, ``p = p0 (p/p0)_oed`` (module docstring) by bisection;
+    ``W`` may be an array. Zero where the load stays inside the initial ellipse
+    (``p0 <= p0_ini``).
+    """
+    W = np.atleast_1d(np.asarray(W, dtype=np.float64))
+    K, xi = mat.bulk, mat.xi
+    lam_oed = oedometric_ratio(mat.M, mat.beta)
+    p_over_p0 = oedometric_point(mat.M, mat.beta)[0]
+    lo = np.zeros_like(W)
+    hi = np.ones_like(W)
+    for _ in range(60):
+        c = 0.5 * (lo + hi)
+        p0 = W * (1.0 - c) / lam_oed
+        p0 = p0 * np.exp(-p0 * p_over_p0 / K)
+        g = c - np.maximum(hardening_collapse(p0, mat.p0_ini, K, xi), 0.0)
+        hi = np.where(g > 0, c, hi)
+        lo = np.where(g > 0, lo, c)
+    return 0.5 * (lo + hi)
+
+
+def oedometric_state(mat: mw.CamClaySnow, axial_strain: float, n: int = 20000, dtype: str = "float64") -> dict:
+    """Uniaxial-strain compaction of one material point with the engine's return (no grid).
+
+    Compresses ``y`` by the logarithmic strain ``axial_strain`` in ``n`` equal
+    increments (material-point driver, MODEL.md 4); returns the final ``p, q,
+    p0`` (Kirchhoff, Pa), ``e = -(log_Jp - log_Jp(0))`` and ``tau_v = p + 2 q/3``.
+    """
+    step = np.diag([1.0, math.exp(-axial_strain / n), 1.0])
+    out = drive_material_points(np.repeat(step[None], n, axis=0), E=mat.E, nu=mat.nu, M=mat.M, beta=mat.beta,
+                                xi=mat.xi, p0_ini=mat.p0_ini, dtype=dtype)
+    p, q = float(out["p"][0, -1]), float(out["q"][0, -1])
+    return {"p": p, "q": q, "p0": float(out["p0"][0, -1]), "tau_v": p + 2.0 * q / 3.0,
+            "e": float(out["log_jp"][0, 0] - out["log_jp"][0, -1])}
+
+
+# --------------------------------------------------------------- set-up
+def weak_layer_column(*, dx: float, xi: float, rho_slab: float, p0_ini: float = 0.0, D_wl: float = 1.0 / 32.0,
+                      h_slab: float = 1.0 / 16.0, E_wl: float = 2.0e5, rho_wl: float = 150.0,
+                      E_slab: float = 1.0e6, nu: float = 0.3, M: float = 1.0, beta: float = 0.3,
+                      ramp: float = 0.1, ppc: int = 2,
+                      precision: str = "float32") -> tuple[mw.Scenario, mw.CamClaySnow, dict]:
+    """Slab on a weak layer in a one-cell column with slip side walls and a sticky floor.
+
+    Use a binary ``dx`` (1/64, 1/128, ...): the box faces then lie exactly on
+    grid nodes (see the wall round-off note in ``tests/test_validation_elastic.py``).
+    Gravity ramps over ``ramp`` (s). The slab on the compacting layer is one
+    mass-spring of stiffness per area ``k = d sigma_v / d u = (lambda_oed xi
+    sqrt(K^2 + p0^2) + tau_v) / (J D_wl)``, stiffening from the start (``J = 1``,
+    ``p0 = p0_ini``) to the closed-form end state. The grid damping is
+    ``2 omega_end``: critical at the end, overdamped before, so the slab never
+    overshoots (an overshoot would compact the layer for good: plasticity
+    ratchets); it acts to the end and leaves the static state unchanged.
+    ``time.end`` is a safe upper bound (6 start and 10 end time constants
+    ``damping / omega^2`` after the ramp); :func:`run_column` stops earlier once
+    the layer has settled.
+
+    Returns ``(scenario, weak-layer material, info)``; ``info`` holds ``W_slab``
+    (Pa), ``omega_start``, ``omega_end`` (rad/s), ``damping`` (1/s), ``end`` (s),
+    ``collapse_theory`` (closed form under the slab weight) and the geometry.
+    """
+    wl = mw.CamClaySnow(E_wl, nu, rho_wl, M=M, beta=beta, xi=xi, p0_ini=p0_ini)
+    slab = mw.Elastic(E_slab, nu, rho_slab)
+    H = D_wl + h_slab
+    W_slab = rho_slab * G * h_slab
+    lam_oed = oedometric_ratio(M, beta)
+    K = wl.bulk
+    m = rho_slab * h_slab + rho_wl * D_wl / 3.0
+    k_start = lam_oed * (xi * math.hypot(K, p0_ini) + p0_ini) / D_wl
+    c_end = float(oedometric_collapse(W_slab, wl)[0])
+    J_end = 1.0 - c_end
+    p0_end = J_end * W_slab / lam_oed
+    k_end = (lam_oed * xi * math.hypot(K, p0_end) + J_end * W_slab) / (J_end * J_end * D_wl)
+    omega_start = math.sqrt(min(k_start, k_end) / m)
+    omega_end = math.sqrt(max(k_start, k_end) / m)
+    damping = 2.0 * omega_end
+    end = ramp + 6.0 * damping / omega_start**2 + 10.0 * damping / omega_end**2
+    n_frames = max(10, math.ceil(end / 0.01))
+    sc = mw.Scenario(
+        name="weak_layer_column",
+        domain=mw.Domain((0.0, 0.0, 0.0), (dx, H + 4.0 * dx, dx), dx, boundary="slip", boundary_faces="xz"),
+        time=mw.TimeControl(end=end, frame_interval=end / n_frames, gravity=(0.0, -G, 0.0), gravity_ramp=ramp,
+                            damping=damping, damping_until=2.0 * end),
+        materials={"weak_layer": wl, "slab": slab},
+        blocks=(mw.Block("weak_layer", (0.0, 0.0, 0.0), (dx, D_wl, dx), particles_per_cell=ppc, name="weak_layer"),
+                mw.Block("slab", (0.0, D_wl, 0.0), (dx, H, dx), particles_per_cell=ppc, name="slab")),
+        walls=(mw.Wall((0.0, 0.0, 0.0), (0.0, 1.0, 0.0), kind="sticky", name="floor"),),
+        output=mw.Output(fields=("x", "log_jp", "p", "q")),
+        precision=precision,
+    )
+    info = {"W_slab": W_slab, "omega_start": omega_start, "omega_end": omega_end, "damping": damping, "end": end,
+            "ramp": ramp, "collapse_theory": c_end, "D_wl": D_wl, "h_slab": h_slab, "rho_slab": rho_slab,
+            "rho_wl": rho_wl, "dx": dx}
+    return sc, wl, info
+
+
+def kirchhoff_stress(F: np.ndarray, mu: float, lam: float) -> np.ndarray:
+    """Hencky Kirchhoff stress ``U diag(2 mu ln s + lam tr ln s) U^T`` (Pa, tension positive), float64."""
+    U, s, _ = np.linalg.svd(np.asarray(F, dtype=np.float64))
+    eps = np.log(s)
+    t = 2.0 * mu * eps + lam * eps.sum(axis=-1, keepdims=True)
+    return np.einsum("nij,nj,nkj->nik", U, t, U)
+
+
+def measure_column(sim: mw.Simulation, wl: mw.CamClaySnow, info: dict) -> dict:
+    """Weak-layer measurements of a settled :func:`weak_layer_column` run.
+
+    Per weak-layer particle: collapse ``c = 1 - exp(log_Jp - log_Jp(0))``, Kirchhoff
+    ``p, q`` and vertical stress, Cauchy ``sigma_v = tau_v / (J_E J_P)``, the
+    overburden ``W`` at its reference height, ``p0`` from ``log_Jp`` and from the
+    ellipse through ``(p, q)``. Returns means and the per-particle arrays.
+    """
+    g = next(gr for gr in sim.model.groups if gr.name == "weak_layer")
+    sl = slice(g.start, g.end)
+    ljp = sim.particle_field("log_jp")[sl].astype(np.float64)
+    F = sim.state.F.numpy()[sl].astype(np.float64)
+    tau = kirchhoff_stress(F, wl.mu, wl.lam)
+    p = -np.trace(tau, axis1=1, axis2=2) / 3.0
+    dev = tau + p[:, None, None] * np.eye(3)
+    q = np.sqrt(1.5 * np.einsum("nij,nij->n", dev, dev))
+    tau_v = -tau[:, 1, 1]
+    dl = ljp - wl.initial_log_jp
+    J = np.linalg.det(F) * np.exp(dl)
+    y0 = sim.x0[sl, 1]
+    W = info["W_slab"] + info["rho_wl"] * G * (info["D_wl"] - y0)
+    K = wl.bulk
+    p0_hard = K * np.sinh(wl.xi * np.maximum(-ljp, 0.0))
+    p0_ell = consolidation_pressure(p, q, wl.M, wl.beta)
+    collapse = 1.0 - np.exp(dl)
+    # geometric thickness: interface between the top weak-layer and bottom slab particle layers
+    x = sim.state.x.numpy().astype(np.float64)
+    gs = next(gr for gr in sim.model.groups if gr.name == "slab")
+    y_wl_top = x[sl, 1].max()
+    y_slab_bot = x[gs.start:gs.end, 1].min()
+    D_now = 0.5 * (y_wl_top + y_slab_bot)
+    theory = oedometric_collapse(W, wl)
+    inner = (y0 > info["dx"]) & (y0 < info["D_wl"] - info["dx"])  # more than a cell from floor and slab
+    return {
+        "collapse": float(collapse.mean()),
+        "collapse_theory": float(theory.mean()),
+        "collapse_interior": float(collapse[inner].mean()) if inner.any() else float("nan"),
+        "collapse_theory_interior": float(theory[inner].mean()) if inner.any() else float("nan"),
+        "collapse_theory_own_state": float(hardening_collapse(p0_ell, wl.p0_ini, K, wl.xi).mean()),
+        "h_c": float(collapse.mean() * info["D_wl"]),
+        "thickness_change": float(info["D_wl"] - D_now),
+        "thickness_change_from_J": float(info["D_wl"] * (1.0 - J.mean())),
+        "sigma_v": float((tau_v / J).mean()),
+        "W_mean": float(W.mean()),
+        "q_over_p": float(q.mean() / p.mean()),
+        "p0": float(p0_hard.mean()),
+        "p0_over_tau_v": float(p0_hard.mean() / tau_v.mean()),
+        "p0_hard_over_ellipse": float(p0_hard.mean() / p0_ell.mean()),
+        "per_particle": {"y0": y0, "collapse": collapse, "W": W, "p": p, "q": q, "tau_v": tau_v, "J": J,
+                         "p0_hard": p0_hard, "p0_ellipse": p0_ell},
+    }
+
+
+def run_column(settle_tol: float = 1e-3, **kwargs) -> tuple[dict, mw.Simulation, dict]:
+    """Build, run and measure a :func:`weak_layer_column`; returns ``(measurements, simulation, info)``.
+
+    Stops at the first frame after the ramp where the slab's mean speed ``v``
+    leaves less than ``settle_tol`` of the expected collapse height to go
+    (``v * 2 / omega_end``, the critically damped time constant). ``info`` gains
+    ``t_settled`` (s), ``steps`` and ``wall_time`` (s, stepping only).
+    """
+    sc, wl, info = weak_layer_column(**kwargs)
+    sim = mw.Simulation(sc, device=DEVICE)
+    gs = next(gr for gr in sim.model.groups if gr.name == "slab")
+    h_expected = info["collapse_theory"] * info["D_wl"]
+
+    def settled(s: mw.Simulation, frame: int):
+        if s.time < info["ramp"]:
+            return None
+        v = float(np.abs(s.state.v.numpy()[gs.start:gs.end, 1].astype(np.float64).mean()))
+        return not (v * 2.0 / info["omega_end"] < settle_tol * h_expected)
+
+    res = sim.run(None, callback=settled)
+    info.update(t_settled=sim.time, steps=res.steps, wall_time=res.wall_time, n_particles=res.n_particles)
+    return measure_column(sim, wl, info), sim, info
+
+
+# ---------------------------------------------------------------- tests
+#: closed form against the engine's own return mapping at one material point (float64, 2e4 increments):
+#: worst seen 7e-4 (xi = 0.16: the O(xi^2) shift of the uniaxial-strain state), else <= 2e-4
+CLOSED_FORM_TOL = 2e-3
+#: mean collapse of the layer against the closed form at 8 cells across it: -1.4 % (xi 0.04) and -0.6 %
+#: (xi 0.02, p0_ini 200 Pa) measured, -1.3..-5.7 % over the mesh study's cases at 8 cells; the deficit is
+#: the slab/layer interface cell (test_collapse_converges_with_dx); 3 % is twice the worst tested case
+COLLAPSE_TOL = 0.03
+#: mean Cauchy sigma_v of the layer against the overburden: -1.0 % and +0.6 % measured
+EQUILIBRIUM_TOL = 0.02
+#: p0 from log_Jp against the ellipse through the particle's (p, q): 1e-5 median measured
+ON_CAP_TOL = 2e-3
+#: geometric thickness change against D_wl (1 - mean J): +0.3 %, +0.6 % measured
+THICKNESS_TOL = 0.03
+
+
+@pytest.mark.parametrize("xi, p0_ini", [(0.01, 0.0), (0.04, 0.0), (0.16, 0.0), (0.04, 300.0), (0.02, 0.0)])
+def test_oedometric_closed_form_matches_material_point(xi, p0_ini):
+    """Uniaxial strain at one point (engine return, float64): collapse = closed form within 2e-3.
+
+    float64 because the float32 driver drifts by about 1 % over 1e4-1e5 tiny
+    increments (round-off rectified by the return mapping, see
+    :func:`test_settled_layer_does_not_creep`). Also checks ``p0 = tau_v /
+    lambda_oed`` and that the naive isotropic formula (``p = W``) and the
+    formula without the Kirchhoff factor ``J`` would be far off.
+    """
+    mat = mw.CamClaySnow(2.0e5, 0.3, 150.0, M=1.0, beta=0.3, xi=xi, p0_ini=p0_ini)
+    st = oedometric_state(mat, axial_strain=0.4 if xi < 0.03 else 0.12, n=20000)
+    c = 1.0 - math.exp(-st["e"])
+    J = math.exp(-st["p"] / mat.bulk) * (1.0 - c)  # J_E J_P with J_E = exp(tr eps) = exp(-p/K)
+    W = st["tau_v"] / J  # the Cauchy load that holds this state
+    closed = float(oedometric_collapse(W, mat)[0])
+    print(f"xi {xi} p0_ini {p0_ini}: collapse {c:.5f}, closed form {closed:.5f} ({closed / c - 1:+.1e}); "
+          f"p0/tau_v {st['p0'] / st['tau_v']:.5f} vs 1/lambda_oed {1 / oedometric_ratio(1.0, 0.3):.5f}")
+    assert closed == pytest.approx(c, rel=CLOSED_FORM_TOL)
+    assert st["p0"] / st["tau_v"] == pytest.approx(1.0 / oedometric_ratio(mat.M, mat.beta), rel=CLOSED_FORM_TOL)
+    assert st["p0"] == pytest.approx(consolidation_pressure(st["p"], st["q"], mat.M, mat.beta), rel=1e-3)
+    assert hardening_collapse(W, p0_ini, mat.bulk, xi) / c - 1.0 > 0.1  # isotropic formula with p = W
+    assert hardening_collapse(W / oedometric_ratio(mat.M, mat.beta), p0_ini, mat.bulk, xi) / c - 1.0 > 0.04
+
+
+def test_oedometric_ratio_closed_form():
+    """lambda_oed = max (p + 2q/3)/p0 on the ellipse, by brute force over the ellipse; (p, q) is that point."""
+    for M, beta in [(1.0, 0.3), (1.2, 0.0), (0.8, 1.0)]:
+        p0 = 1.0
+        t = np.linspace(0.0, math.pi, 200001)
+        a = 0.5 * p0 * (1.0 + beta)
+        p = 0.5 * p0 * (1.0 - beta) + a * np.cos(t)
+        q = M * a / math.sqrt(1.0 + 2.0 * beta) * np.sin(t)
+        k = np.argmax(p + 2.0 * q / 3.0)
+        assert oedometric_ratio(M, beta) == pytest.approx(p[k] + 2.0 * q[k] / 3.0, rel=1e-9)
+        assert oedometric_point(M, beta) == pytest.approx((p[k], q[k]), abs=1e-4)
+        assert consolidation_pressure(p[k], q[k], M, beta) == pytest.approx(p0, rel=1e-9)
+    assert oedometric_ratio(1.0, 0.3) == pytest.approx(1.08475, rel=1e-5)
+
+
+@pytest.mark.parametrize("xi, rho_slab, p0_ini", [(0.04, 1200.0, 0.0), (0.02, 2400.0, 200.0)])
+def test_weak_layer_collapse_under_slab(xi, rho_slab, p0_ini):
+    """Slab on a weak layer, 8 cells across it (float32): 1 - J_P and h_c against the closed form.
+
+    xi 0.04, rho_s 1200 (W = 736 Pa + layer weight): collapse 0.0894 vs 0.0907 (-1.4 %), h_c 2.79 mm.
+    xi 0.02, rho_s 2400, p0_ini 200 Pa: 0.2257 vs 0.2271 (-0.6 %), h_c 7.05 mm.
+    """
+    m, sim, info = run_column(dx=1.0 / 256.0, xi=xi, rho_slab=rho_slab, p0_ini=p0_ini)
+    pp = m["per_particle"]
+    err = m["collapse"] / m["collapse_theory"] - 1.0
+    print(f"collapse {m['collapse']:.5f} vs {m['collapse_theory']:.5f} ({err:+.4f}); h_c {m['h_c'] * 1e3:.3f} mm; "
+          f"sigma_v {m['sigma_v']:.1f} vs W {m['W_mean']:.1f} Pa; q/p {m['q_over_p']:.3f}; "
+          f"steps {info['steps']}, {info['wall_time']:.1f} s")
+    assert abs(err) < COLLAPSE_TOL
+    assert m["h_c"] == pytest.approx(m["collapse_theory"] * info["D_wl"], rel=COLLAPSE_TOL)
+    assert m["sigma_v"] == pytest.approx(m["W_mean"], rel=EQUILIBRIUM_TOL)
+    assert m["thickness_change"] == pytest.approx(m["thickness_change_from_J"], rel=THICKNESS_TOL)
+    # on the cap: p0(log_Jp) = p0 of the ellipse through (p, q); never outside the ellipse
+    ratio = pp["p0_hard"] / pp["p0_ellipse"]
+    assert abs(np.median(ratio) - 1.0) < ON_CAP_TOL
+    assert ratio.min() > 1.0 - ON_CAP_TOL
+    # uniaxial strain: p0 = tau_v / lambda_oed, not p0 = p (q/p = 0.26, not 0)
+    assert m["p0_over_tau_v"] == pytest.approx(1.0 / oedometric_ratio(1.0, 0.3), rel=0.01)
+    assert m["q_over_p"] > 0.15  # 0.265 in float64; the float32 creep lowers it (test_settled_layer_does_not_creep)
+
+
+def test_collapse_converges_with_dx():
+    """The layer under-compacts in the cell it shares with the slab: the deficit falls with dx.
+
+    xi 0.04, rho_s 1200: -11 % at 4 cells across the layer, -1.4 % at 8 (the
+    top half-cell of particles compacts to ~0.3 of the closed form at 8 cells;
+    the interior within a few %).
+    """
+    errs = []
+    for dx in (1.0 / 128.0, 1.0 / 256.0):
+        m, _, _ = run_column(dx=dx, xi=0.04, rho_slab=1200.0)
+        errs.append(m["collapse"] / m["collapse_theory"] - 1.0)
+    print(f"collapse error at 4 and 8 cells: {errs}")
+    assert -0.2 < errs[0] < -0.05
+    assert abs(errs[1]) < abs(errs[0]) / 3.0
+
+
+@pytest.mark.parametrize("precision", [
+    "float32",
+    "float64"])
+def test_settled_layer_does_not_creep(precision):
+    """Under a constant load the settled layer must stay put, in float32 as in float64.
+
+    Guards the fix in kernels/p2g.py: F_E after an active return is written as a
+    correction of F_tr instead of being rebuilt from the float32 SVD factors.
+
+    xi 0.01, rho_s 2400 (collapse 0.38), 8 cells; the slab settles by t = 0.4 s.
+    Between 0.5 and 0.9 s, float32 (measured): the slab sinks at ~3e-5 m/s,
+    the collapse grows 0.3832 -> 0.3841 (+0.2 %) and q/p drifts 0.238 -> 0.217
+    (0.15 by 1.8 s); float64: slab speed 1e-14 m/s, nothing changes, q/p stays
+    at the uniaxial-strain value 0.259.
+    """
+    sc, mat, info = weak_layer_column(dx=1.0 / 256.0, xi=0.01, rho_slab=2400.0, precision=precision)
+    sim = mw.Simulation(sc, device=DEVICE)
+    sim.run(None, end_time=0.5, frame_interval=0.1)
+    m1 = measure_column(sim, mat, info)
+    sim.run(None, end_time=0.9, frame_interval=0.1)
+    m2 = measure_column(sim, mat, info)
+    print(f"{precision}: collapse {m1['collapse']:.6f} -> {m2['collapse']:.6f}, q/p {m1['q_over_p']:.4f} -> "
+          f"{m2['q_over_p']:.4f} from 0.5 to 0.9 s")
+    assert abs(m2["collapse"] / m1["collapse"] - 1.0) < 1e-4
+    assert abs(m2["q_over_p"] - m1["q_over_p"]) < 1e-3
+    p_k0, q_k0 = oedometric_point(mat.M, mat.beta)
+    assert m2["q_over_p"] == pytest.approx(q_k0 / p_k0, rel=0.03)
+    assert m2["p0_over_tau_v"] == pytest.approx(1.0 / oedometric_ratio(mat.M, mat.beta), rel=0.01)
