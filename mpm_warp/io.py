@@ -3,8 +3,8 @@
 Run file layout (``format = "mpm_warp-run"``, ``format_version = 1``)::
 
     /                    attrs: format, format_version, created (ISO 8601, UTC), n_particles,
-                         units, versions, scenario, ... (dicts and lists as JSON text, their
-                         names listed in the ``json_attrs`` attribute)
+                         units, versions, scenario, resumed, ... (dicts and lists as JSON text,
+                         their names listed in the ``json_attrs`` attribute)
     /time                (n_frames,) float64 [s]
     /step                (n_frames,) int64 [1]
     /particles/<name>    (n_frames, N, *shape), declared dtype; chunk = one frame, compressed
@@ -12,27 +12,28 @@ Run file layout (``format = "mpm_warp-run"``, ``format_version = 1``)::
     /walls/forces        (n_frames, n_walls, 3) float64 [N]; attr ``names`` (JSON list)
     /scalars/<name>      (n_frames,) float64, e.g. kinetic and elastic energy [J]
 
-Every dataset carries a ``unit`` attribute. Compression: ``"gzip"`` is shuffle + gzip level 1
-(readable by every HDF5 tool; level 4 gave the same size, 10-30 % slower), ``"lzf"`` is
-shuffle + LZF (about 3.5x faster to write, ~10 % larger, h5py-only filter), ``"none"``.
+Every dataset has a ``unit`` attribute. Compression of particle data: ``"gzip"`` = shuffle +
+gzip level 1 (any HDF5 tool reads it; level 4 was no smaller and 10-30 % slower), ``"lzf"`` =
+shuffle + LZF (about 3.5x faster to write, ~10 % larger, an h5py-only filter), ``"none"``.
 
-Frame whole or not at all
--------------------------
-The file is created with superblock v3 (``libver="v110"``, readable by HDF5 >= 1.10), every
-dataset is created up front, then the writer enters SWMR mode. In SWMR mode HDF5 writes its
-metadata with flush dependencies, so whatever prefix of its writes reaches the file, the file
-stays consistent; ``H5Fflush`` writes raw chunks before metadata. :meth:`RunWriter.write_frame`
-checks every input first, then grows and fills each per-frame dataset (``time`` last) and
-flushes. A frame is complete when every per-frame dataset holds its row; readers take
-``n_frames = min(lengths)``, so a kill between two dataset headers, or an exception between two
-datasets, never shows a partial frame. A killed writer (SIGKILL, default SIGTERM, OOM) leaves
-the superblock marked "open for write": plain HDF5 refuses it ("may use h5clear"), so
-:func:`read_run` opens with ``swmr=True``, which reads it (and reads a run still being written).
-SIGINT raises ``KeyboardInterrupt`` between HDF5 calls and ``__exit__`` closes the file cleanly.
-Resuming (:meth:`RunWriter.reopen`) truncates a cleanly closed file in place; a killed one is
-rebuilt: its complete frames are copied chunk by chunk (raw, not recompressed) into a sibling
-file that then replaces it. Protected: process death. Not protected: power loss (no fsync per
-frame) and network file systems, where SWMR's write ordering does not hold.
+Crash safety: a frame is written whole or not at all
+----------------------------------------------------
+Files use superblock v3 (``libver="v110"``, read by HDF5 >= 1.10) and are written in SWMR
+mode, in which HDF5 orders its metadata writes (flush dependencies) so that the file is
+consistent after any prefix of them, and ``H5Fflush`` writes raw chunks before metadata.
+:meth:`RunWriter.write_frame` checks every input, grows and fills each per-frame dataset
+(``time`` last) and flushes. A frame is complete when every per-frame dataset holds its row;
+readers take ``n_frames = min(lengths)``, so a kill between two dataset headers, or an
+exception between two datasets, never shows a partial frame. A file is never touched outside
+SWMR mode: it is built aside (``<path>.part``), switched to SWMR, then renamed over ``path``.
+A killed writer (SIGKILL, default SIGTERM, OOM) leaves the superblock marked "open for write",
+which plain HDF5 refuses ("use h5clear"); :func:`read_run` opens with ``swmr=True``, which reads
+it (and runs still being written). SIGINT raises ``KeyboardInterrupt`` between HDF5 calls and
+``__exit__`` closes the file cleanly. :meth:`RunWriter.reopen` (resume) copies the kept frames
+chunk by chunk (raw bytes, no recompression) into a rebuilt file that replaces the old one, so a
+kill during resume leaves the old file or the new one. Verified by killing a writer (strace
+fault injection) at every one of its ``pwrite`` calls. Protected: death of the process. Not
+protected: power loss (no fsync per frame), network file systems (no SWMR write ordering).
 """
 
 from __future__ import annotations
@@ -63,34 +64,28 @@ def _now() -> str:
     return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
 
 
-def _json_default(o):
-    if isinstance(o, (np.generic, np.ndarray)):
-        return o.tolist()
-    raise TypeError(f"{type(o).__name__} is not JSON serialisable")
+def _to_json(value) -> str:
+    def default(o):
+        if isinstance(o, (np.generic, np.ndarray)):
+            return o.tolist()
+        raise TypeError(f"{type(o).__name__} is not JSON serialisable")
+    return json.dumps(value, default=default)
 
 
 def _set_attrs(obj, attrs: dict) -> None:
     """Store ``attrs`` on an HDF5 object; dicts, lists, tuples and None go as JSON text."""
     as_json = set(json.loads(obj.attrs.get("json_attrs", "[]")))
     for key, value in attrs.items():
-        if isinstance(value, (dict, list, tuple)) or value is None:
-            obj.attrs[key] = json.dumps(value, default=_json_default)
-            as_json.add(key)
-        else:
-            obj.attrs[key] = value
-            as_json.discard(key)
+        is_json = isinstance(value, (dict, list, tuple)) or value is None
+        obj.attrs[key] = _to_json(value) if is_json else value
+        (as_json.add if is_json else as_json.discard)(key)
     obj.attrs["json_attrs"] = json.dumps(sorted(as_json))
 
 
 def _get_attrs(obj) -> dict:
     as_json = set(json.loads(obj.attrs.get("json_attrs", "[]")))
-    out = {}
-    for key, value in obj.attrs.items():
-        if key in as_json:
-            value = json.loads(value)
-        elif isinstance(value, np.generic):
-            value = value.item()
-        out[key] = value
+    out = {k: json.loads(v) if k in as_json else v.item() if isinstance(v, np.generic) else v
+           for k, v in obj.attrs.items()}
     out.pop("json_attrs", None)
     return out
 
@@ -116,19 +111,20 @@ def _check_format(f: h5py.File, expected: str) -> None:
 
 
 def _series(f: h5py.File) -> list[h5py.Dataset]:
-    """Every per-frame dataset; ``time`` last (the order they are written in)."""
-    out = [f[f"particles/{n}"] for n in f["particles"]] + [f[f"scalars/{n}"] for n in f["scalars"]]
-    if "walls/forces" in f:
-        out.append(f["walls/forces"])
-    return out + [f["step"], f["time"]]
-
-
-def _complete_frames(f: h5py.File) -> int:
-    """Number of complete frames: the shortest per-frame dataset."""
+    """Every per-frame dataset, in the order they are written (``time`` last)."""
     try:
-        return min(d.shape[0] for d in _series(f))
+        out = [*f["particles"].values(), *f["scalars"].values()]
+        return out + ([f["walls/forces"]] if "walls/forces" in f else []) + [f["step"], f["time"]]
     except KeyError as e:
         raise OutputError(f"{f.filename}: incomplete run file ({e})") from e
+
+
+def _layout(f: h5py.File) -> tuple:
+    """``(n_particles, particle_fields, wall_names, scalar_series)`` of an open run file."""
+    return (int(f.attrs["n_particles"]),
+            {k: (d.shape[2:], d.dtype.str, d.attrs["unit"]) for k, d in f["particles"].items()},
+            json.loads(f["walls/forces"].attrs["names"]) if "walls/forces" in f else [],
+            {k: d.attrs["unit"] for k, d in f["scalars"].items()})
 
 
 def _check_name(kind: str, name: str) -> None:
@@ -146,25 +142,25 @@ class RunWriter:
     n_particles : int
         Number of particles N.
     particle_fields : dict
-        ``name -> (per-particle shape, numpy dtype, unit)``, e.g. ``{"x": ((3,), "float32", "m")}``.
-        Only these fields are stored.
+        ``name -> (per-particle shape, numpy dtype, unit)``, e.g. ``{"x": ((3,), "float32", "m")}``;
+        only these fields are stored.
     static_fields : dict, optional
         ``name -> (array (N, ...), unit)``: per-particle constants written once.
     wall_names : sequence of str
-        Walls whose reaction force [N] is stored per frame, ``(n_frames, n_walls, 3)``.
+        Walls whose reaction force [N] is stored per frame.
     scalar_series : dict, optional
         Per-frame scalars ``name -> unit``, e.g. ``{"kinetic_energy": "J"}``.
     attrs : dict, optional
-        Run attributes (scenario, versions, device, precision, units, ...); dicts as JSON text.
+        Run attributes (scenario, versions, device, precision, units, ...).
     compression : {"gzip", "lzf", "none"}
-        Filter of the per-particle datasets.
+        Filter of the particle datasets.
     overwrite : bool
         Replace an existing file; if False an existing ``path`` raises :class:`OutputError`.
     append : bool
-        Extend ``path`` if it exists (its layout must equal the one given), after truncating it
-        to ``keep_frames`` complete frames (default: all complete frames).
+        Extend ``path`` if it exists; its layout must equal the one given (static fields,
+        compression and the attributes already stored are kept).
     keep_frames : int, optional
-        Frames kept when appending, e.g. the frame count stored in the checkpoint resumed from.
+        With ``append``: complete frames kept (default all), e.g. those of the checkpoint resumed.
     """
 
     def __init__(self, path, *, n_particles: int,
@@ -173,13 +169,12 @@ class RunWriter:
                  wall_names=(), scalar_series: dict[str, str] | None = None,
                  attrs: dict | None = None, compression: str = "gzip", overwrite: bool = True,
                  append: bool = False, keep_frames: int | None = None):
-        self.path = os.fspath(path)
+        self.path, self._f = os.fspath(path), None
         if not isinstance(n_particles, (int, np.integer)) or n_particles < 1:
             raise InvalidArgument("n_particles", n_particles, "an integer >= 1")
         if compression not in _COMPRESSION:
             raise InvalidArgument("compression", compression, f"one of {sorted(_COMPRESSION)}")
-        self.n_particles = int(n_particles)
-        self._fields = {}
+        self.n_particles, self._fields = int(n_particles), {}
         for name, spec in particle_fields.items():
             _check_name("particle_fields", name)
             try:
@@ -188,14 +183,11 @@ class RunWriter:
             except (TypeError, ValueError) as e:
                 raise InvalidArgument(f"particle_fields[{name!r}]", spec,
                                       "(shape tuple, numpy dtype name, unit)") from e
+            if self.n_particles * self._fields[name][1].itemsize * int(np.prod(shape)) >= 2**32:
+                raise InvalidArgument(f"particle_fields[{name!r}]", spec, f"a frame under 4 GiB "
+                                      f"(HDF5 chunk limit) for {n_particles} particles")
         self.wall_names = [str(w) for w in wall_names]
-        self._scalars = dict(scalar_series or {})
-        for name in self._scalars:
-            _check_name("scalar_series", name)
-        attrs = dict(attrs or {})
-        bad = _RESERVED_ATTRS & attrs.keys()
-        if bad:
-            raise InvalidArgument("attrs", sorted(bad), f"no reserved keys {sorted(_RESERVED_ATTRS)}")
+        self._scalars = {name: str(unit) for name, unit in (scalar_series or {}).items()}
         static = {}
         for name, (array, unit) in (static_fields or {}).items():
             _check_name("static_fields", name)
@@ -203,52 +195,86 @@ class RunWriter:
             if static[name][0].ndim < 1 or static[name][0].shape[0] != n_particles:
                 raise InvalidArgument(f"static_fields[{name!r}].shape", static[name][0].shape,
                                       f"({n_particles}, ...)")
+        for name in self._scalars:
+            _check_name("scalar_series", name)
+        names = [*self._fields, *self._scalars, *static, "wall_forces"]
+        if len(set(names)) < len(names):
+            raise InvalidArgument("field names", names, "names unique across particle fields, "
+                                  "scalars, static fields and 'wall_forces'")
+        attrs = dict(attrs or {})
+        if _RESERVED_ATTRS & attrs.keys():
+            raise InvalidArgument("attrs", sorted(attrs), f"no reserved key {sorted(_RESERVED_ATTRS)}")
         if append and os.path.exists(self.path):
-            self._f = self._open_append(keep_frames, attrs)
+            self._f = self._resume(keep_frames, attrs)
         else:
             if os.path.exists(self.path) and not overwrite:
                 raise OutputError(f"{self.path}: exists (pass overwrite=True to replace it)")
-            self._f = self._create(self.path, static, attrs, compression)
-            self._n = 0
-        try:
-            self._f.swmr_mode = True          # from here on no new objects, only growing datasets
-        except BaseException:
-            self._f.close()
-            raise
+            self._f, self._n = self._build(static, attrs, compression), 0
+        self._datasets = {d.name.lstrip("/"): d for d in _series(self._f)}
 
     @classmethod
     def reopen(cls, path, *, keep_frames: int | None = None, attrs: dict | None = None) -> RunWriter:
-        """Reopen an existing run (also one whose writer was killed) to append frames.
+        """Reopen a run (also one whose writer was killed) to append frames, e.g. to resume it.
 
-        The layout is read from the file; ``keep_frames`` complete frames are kept (all if None).
+        The layout is read from the file; ``keep_frames`` complete frames are kept (all if
+        None); ``attrs`` are added to the stored attributes.
         """
         with _open_read(path) as f:
             _check_format(f, FORMAT)
-            fields = {n: (d.shape[2:], d.dtype.str, d.attrs["unit"]) for n, d in f["particles"].items()}
-            walls = json.loads(f["walls/forces"].attrs["names"]) if "walls/forces" in f else []
-            scalars = {n: d.attrs["unit"] for n, d in f["scalars"].items()}
-            n_particles = int(f.attrs["n_particles"])
+            n_particles, fields, walls, scalars = _layout(f)
         return cls(path, n_particles=n_particles, particle_fields=fields, wall_names=walls,
                    scalar_series=scalars, attrs=attrs, append=True, keep_frames=keep_frames)
 
-    def _create(self, path, static_fields, attrs, compression) -> h5py.File:
-        f = h5py.File(path, "w", libver=_LIBVER)
+    def _resume(self, keep_frames, attrs) -> h5py.File:
+        layout = (self.n_particles, {k: (s, d.str, u) for k, (s, d, u) in self._fields.items()},
+                  self.wall_names, self._scalars)
+        with _open_read(self.path) as src:
+            _check_format(src, FORMAT)
+            complete, found = min(d.shape[0] for d in _series(src)), _layout(src)
+            if found != layout:
+                raise InvalidArgument("layout (n_particles, particle_fields, wall_names, "
+                                      "scalar_series)", layout, f"the layout of {self.path}: {found}")
+            keep = complete if keep_frames is None else keep_frames
+            if not isinstance(keep, (int, np.integer)) or not 0 <= keep <= complete:
+                raise InvalidArgument("keep_frames", keep_frames, f"an integer in [0, {complete}]")
+            old = _get_attrs(src)
+            resumed = old.pop("resumed", []) + [{"at": _now(), "kept_frames": int(keep)}]
+            attrs = {k: v for k, v in old.items() if k not in _RESERVED_ATTRS} | attrs
+            static = {k: (d[()], d.attrs["unit"]) for k, d in src["static"].items()}
+            first = next(iter(src["particles"].values()), None)
+            compression = {"gzip": "gzip", "lzf": "lzf"}.get(getattr(first, "compression", 0), "none")
+            f = self._build(static, {**attrs, "resumed": resumed}, compression, src, int(keep))
+        self._n = int(keep)
+        return f
+
+    def _build(self, static, attrs, compression, src=None, keep=0) -> h5py.File:
+        """Write the file aside, with the first ``keep`` frames of ``src`` if given, switch it to
+        SWMR mode and move it over ``path``: a kill leaves the old file or the new one."""
+        part = self.path + ".part"
+        f = h5py.File(part, "w", libver=_LIBVER)
         try:
-            f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, created=_now(),
-                           n_particles=self.n_particles)
-            versions = dict(attrs.pop("versions", None) or {})
-            for key, value in (("h5py", h5py.__version__), ("hdf5", h5py.version.hdf5_version),
-                               ("numpy", np.__version__)):
-                versions.setdefault(key, value)
+            f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, n_particles=self.n_particles,
+                           created=src.attrs["created"] if src else _now())
+            versions = {"h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
+                        "numpy": np.__version__} | (attrs.get("versions") or {})
             units = {"length": "m", "time": "s", "mass": "kg", "force": "N", "energy": "J"}
-            units.update(attrs.pop("units", None) or {})
-            _set_attrs(f, {**attrs, "versions": versions, "units": units})
+            _set_attrs(f, {**attrs, "versions": versions, "units": units | (attrs.get("units") or {})})
             n, filt = self.n_particles, _COMPRESSION[compression]
 
             def series(name, dtype, unit, shape=(), chunk=_SERIES_CHUNK, **kw):
-                d = f.create_dataset(name, shape=(0, *shape), maxshape=(None, *shape), dtype=dtype,
+                d = f.create_dataset(name, shape=(keep, *shape), maxshape=(None, *shape), dtype=dtype,
                                      chunks=(chunk, *shape), **kw)
                 d.attrs["unit"] = unit
+                if src and keep and chunk == 1 and src[name].chunks == d.chunks and \
+                        (src[name].compression, src[name].shuffle) == (d.compression, d.shuffle):
+                    for i in range(src[name].id.get_num_chunks()):   # copy compressed bytes as is
+                        info = src[name].id.get_chunk_info(i)
+                        if info.chunk_offset[0] < keep:
+                            raw = src[name].id.read_direct_chunk(info.chunk_offset)[1]
+                            d.id.write_direct_chunk(info.chunk_offset, raw, info.filter_mask)
+                elif src and keep:
+                    for i in range(0, keep, chunk):
+                        d[i:i + chunk] = src[name][i:min(i + chunk, keep)]
                 return d
 
             series("time", "f8", "s")
@@ -257,7 +283,7 @@ class RunWriter:
             for name, (shape, dtype, unit) in self._fields.items():
                 series(f"particles/{name}", dtype, unit, (n, *shape), chunk=1, **filt)
             f.create_group("static", track_order=True)
-            for name, (array, unit) in static_fields.items():
+            for name, (array, unit) in static.items():
                 f.create_dataset(f"static/{name}", data=array, **filt).attrs["unit"] = unit
             f.create_group("scalars", track_order=True)
             for name, unit in self._scalars.items():
@@ -265,42 +291,13 @@ class RunWriter:
             if self.wall_names:
                 series("walls/forces", "f8", "N", (len(self.wall_names), 3)).attrs["names"] = \
                     json.dumps(self.wall_names)
-            f.flush()
+            f.swmr_mode = True                # flushes; from here on datasets only grow
+            os.replace(part, self.path)
             return f
         except BaseException:
             f.close()
+            os.remove(part)
             raise
-
-    def _open_append(self, keep_frames, attrs) -> h5py.File:
-        layout = (self.n_particles, {k: (s, d.str, u) for k, (s, d, u) in self._fields.items()},
-                  self.wall_names, self._scalars)
-        with _open_read(self.path) as f:
-            _check_format(f, FORMAT)
-            complete = _complete_frames(f)
-            found = (int(f.attrs["n_particles"]),
-                     {k: (d.shape[2:], d.dtype.str, d.attrs["unit"]) for k, d in f["particles"].items()},
-                     json.loads(f["walls/forces"].attrs["names"]) if "walls/forces" in f else [],
-                     {k: d.attrs["unit"] for k, d in f["scalars"].items()})
-        if found != layout:
-            raise InvalidArgument("layout (n_particles, particle_fields, wall_names, scalar_series)",
-                                  layout, f"the layout of {self.path}: {found}")
-        keep = complete if keep_frames is None else keep_frames
-        if not isinstance(keep, (int, np.integer)) or not 0 <= keep <= complete:
-            raise InvalidArgument("keep_frames", keep_frames, f"an integer in [0, {complete}]")
-        try:
-            f = h5py.File(self.path, "r+", libver=_LIBVER)
-        except OSError as e:
-            if "already open for write" not in str(e):
-                raise OutputError(f"{self.path}: cannot reopen for writing ({e})") from e
-            _rebuild(self.path, keep)          # writer was killed: copy the complete frames
-            f = h5py.File(self.path, "r+", libver=_LIBVER)
-        for d in _series(f):
-            d.resize(keep, axis=0)
-        history = json.loads(f.attrs.get("resumed", "[]"))
-        _set_attrs(f, {**attrs, "resumed": history + [{"at": _now(), "kept_frames": int(keep)}]})
-        f.flush()
-        self._n = int(keep)
-        return f
 
     @property
     def n_frames(self) -> int:
@@ -335,15 +332,14 @@ class RunWriter:
         time = float(time)
         if not np.isfinite(time):
             raise InvalidArgument("time", time, "a finite number of seconds")
-        rows = {}
         if particles.keys() != self._fields.keys():
             raise InvalidArgument("particles (field names)", sorted(particles),
                                   f"exactly the declared fields {sorted(self._fields)}")
+        rows = {}
         for name, (shape, dtype, _) in self._fields.items():
             a = np.asarray(particles[name])
-            expected = (self.n_particles, *shape)
-            if a.shape != expected:
-                raise InvalidArgument(f"particles[{name!r}].shape", a.shape, str(expected))
+            if a.shape != (self.n_particles, *shape):
+                raise InvalidArgument(f"particles[{name!r}].shape", a.shape, str((self.n_particles, *shape)))
             if not np.can_cast(a.dtype, dtype, "same_kind"):
                 raise InvalidArgument(f"particles[{name!r}].dtype", a.dtype.name, f"castable to {dtype}")
             rows[f"particles/{name}"] = a.astype(dtype, copy=False)
@@ -353,28 +349,26 @@ class RunWriter:
                                   f"exactly the declared series {sorted(self._scalars)}")
         rows.update({f"scalars/{k}": float(v) for k, v in scalars.items()})
         if self.wall_names:
-            w = np.asarray(wall_forces, dtype=float) if wall_forces is not None else None
-            expected = (len(self.wall_names), 3)
-            if w is None or w.shape != expected:
-                raise InvalidArgument("wall_forces.shape", None if w is None else w.shape, str(expected))
+            w = None if wall_forces is None else np.asarray(wall_forces, dtype=float)
+            if w is None or w.shape != (len(self.wall_names), 3):
+                raise InvalidArgument("wall_forces.shape", None if w is None else w.shape,
+                                      str((len(self.wall_names), 3)))
             rows["walls/forces"] = w
-        rows["step"] = int(step)
-        rows["time"] = time                   # dicts keep order: time is written last
+        rows["step"], rows["time"] = int(step), time          # time is written last
         n = self._n
         for name, value in rows.items():
-            d = self._f[name]
-            d.resize(n + 1, axis=0)
-            d[n] = value
+            self._datasets[name].resize(n + 1, axis=0)
+            self._datasets[name][n] = value
         self._f.flush()
         self._n = n + 1
         return n
 
     def close(self) -> None:
-        """Trim a partly written frame (after an exception) and close the file."""
+        """Trim a partly written frame (left by an exception) and close the file."""
         if self._f is None:
             return
         try:
-            for d in _series(self._f):
+            for d in self._datasets.values():
                 if d.shape[0] != self._n:
                     d.resize(self._n, axis=0)
         finally:
@@ -388,33 +382,6 @@ class RunWriter:
         self.close()
 
 
-def _rebuild(path: str, keep: int) -> None:
-    """Copy the first ``keep`` frames of a run whose writer died into a clean file, replacing it."""
-    tmp = path + ".rebuild"
-    with _open_read(path) as src, h5py.File(tmp, "w", libver=_LIBVER) as dst:
-        _set_attrs(dst, _get_attrs(src))
-        for name, obj in src.items():
-            if isinstance(obj, h5py.Group):
-                dst.create_group(name, track_order=True)
-        for name, obj in src["static"].items():
-            src.copy(obj, dst["static"], name=name)
-        for d in _series(src):
-            kw = {} if d.compression is None else dict(compression=d.compression,
-                                                        compression_opts=d.compression_opts)
-            e = dst.create_dataset(d.name, shape=(keep, *d.shape[1:]), maxshape=d.maxshape,
-                                   chunks=d.chunks, dtype=d.dtype, shuffle=d.shuffle, **kw)
-            e.attrs.update(d.attrs)
-            if d.chunks[0] == 1:              # one frame per chunk: copy compressed bytes as they are
-                for i in range(d.id.get_num_chunks()):
-                    info = d.id.get_chunk_info(i)
-                    if info.chunk_offset[0] < keep:
-                        raw = d.id.read_direct_chunk(info.chunk_offset)[1]
-                        e.id.write_direct_chunk(info.chunk_offset, raw, info.filter_mask)
-            elif keep:
-                e[:] = d[:keep]
-    os.replace(tmp, path)
-
-
 class RunData:
     """Contents of a run file; small series are loaded, particle fields read on demand.
 
@@ -424,10 +391,9 @@ class RunData:
     attrs : dict
         Root attributes, JSON-decoded where stored as JSON.
     scenario : dict or None
-        The scenario, parsed from ``attrs["scenario"]`` (JSON or TOML text).
-    n_frames : int
-        Number of complete frames.
-    n_particles : int
+        The scenario, parsed from ``attrs["scenario"]`` (a dict, or JSON or TOML text).
+    n_frames, n_particles : int
+        Number of complete frames and of particles.
     times, steps : ndarray (n_frames,)
         Simulated time [s] and step of each frame.
     particle_fields : list of str
@@ -444,23 +410,20 @@ class RunData:
         self.path = os.fspath(path)
         with _open_read(self.path) as f:
             _check_format(f, FORMAT)
-            n = self.n_frames = _complete_frames(f)
+            n = self.n_frames = min(d.shape[0] for d in _series(f))
             self.attrs = _get_attrs(f)
             self.n_particles = int(self.attrs["n_particles"])
             self.times, self.steps = f["time"][:n], f["step"][:n]
-            self._shapes = {k: d.shape[1:] for k, d in f["particles"].items()}
-            self.particle_fields = list(self._shapes)
+            self.particle_fields = list(f["particles"])
             self.static = {k: d[()] for k, d in f["static"].items()}
             self.scalars = {k: d[:n] for k, d in f["scalars"].items()}
             self.units = {"time": "s", "step": "1"}
             for group in ("particles", "static", "scalars"):
                 self.units.update({k: d.attrs["unit"] for k, d in f[group].items()})
+            self.wall_names, self.wall_forces = [], np.zeros((n, 0, 3))
             if "walls/forces" in f:
                 self.wall_names = json.loads(f["walls/forces"].attrs["names"])
-                self.wall_forces = f["walls/forces"][:n]
-                self.units["wall_forces"] = "N"
-            else:
-                self.wall_names, self.wall_forces = [], np.zeros((n, 0, 3))
+                self.wall_forces, self.units["wall_forces"] = f["walls/forces"][:n], "N"
 
     @property
     def scenario(self) -> dict | None:
@@ -476,20 +439,16 @@ class RunData:
                 import tomli as tomllib
             return tomllib.loads(s)
 
-    def _index(self, i: int) -> int:
-        if not -self.n_frames <= i < self.n_frames:
-            raise InvalidArgument("frame", i, f"an index in [{-self.n_frames}, {self.n_frames})")
-        return i % self.n_frames
-
     def frame(self, i: int) -> dict[str, np.ndarray]:
         """Particle fields of complete frame ``i`` (negative counts from the end)."""
-        i = self._index(i)
+        if not -self.n_frames <= i < self.n_frames:
+            raise InvalidArgument("frame", i, f"an index in [{-self.n_frames}, {self.n_frames})")
         with _open_read(self.path) as f:
-            return {k: f[f"particles/{k}"][i] for k in self.particle_fields}
+            return {k: f[f"particles/{k}"][i % self.n_frames] for k in self.particle_fields}
 
     def field(self, name: str) -> np.ndarray:
         """One particle field over all complete frames, ``(n_frames, N, *shape)``."""
-        if name not in self._shapes:
+        if name not in self.particle_fields:
             raise InvalidArgument("field", name, f"one of {self.particle_fields}")
         with _open_read(self.path) as f:
             return f[f"particles/{name}"][: self.n_frames]
@@ -521,14 +480,14 @@ def write_checkpoint(path, arrays: dict[str, np.ndarray], meta: dict) -> None:
     arrays : dict of str -> ndarray
         State arrays, stored uncompressed (speed) under their names ('/' makes groups).
     meta : dict
-        JSON-serialisable description (step, time, frame count, scenario, ...).
+        JSON-serialisable description (step, time, frames written, scenario, ...).
     """
     path = os.fspath(path)
     tmp = path + ".tmp"
     try:
         with h5py.File(tmp, "w") as f:
             f.attrs.update(format=CHECKPOINT_FORMAT, format_version=FORMAT_VERSION, created=_now(),
-                           meta=json.dumps(meta, default=_json_default))
+                           meta=_to_json(meta))
             for name, a in arrays.items():
                 f.create_dataset(name, data=np.asarray(a))
         fd = os.open(tmp, os.O_RDONLY)
@@ -541,12 +500,12 @@ def write_checkpoint(path, arrays: dict[str, np.ndarray], meta: dict) -> None:
         if os.path.exists(tmp):
             os.remove(tmp)
         raise
-    try:
-        dfd = os.open(os.path.dirname(os.path.abspath(path)), os.O_RDONLY)
+    try:                                      # make the rename itself durable
+        fd = os.open(os.path.dirname(os.path.abspath(path)), os.O_RDONLY)
         try:
-            os.fsync(dfd)
+            os.fsync(fd)
         finally:
-            os.close(dfd)
+            os.close(fd)
     except OSError:                           # directories cannot be fsynced everywhere
         pass
 

@@ -12,9 +12,13 @@ from collections.abc import Callable
 
 from .errors import ScenarioError
 
-__all__ = ["register_scene", "expand_scene", "SCENE_BUILDERS"]
+__all__ = ["register_scene", "register_scene_hooks", "expand_scene", "attach_scene", "SCENE_BUILDERS",
+           "SCENE_HOOKS"]
 
 SCENE_BUILDERS: dict[str, Callable[[dict], dict]] = {}
+#: scene kind -> ``attach(sim)``: adds the scene's device actions (``sim.stepper.actions``), frame
+#: diagnostics (``sim.frame_diagnostics``) and result analyses (``sim.result_hooks``) to a Simulation
+SCENE_HOOKS: dict[str, Callable] = {}
 
 
 def register_scene(kind: str):
@@ -25,6 +29,19 @@ def register_scene(kind: str):
         return fn
 
     return deco
+
+
+def register_scene_hooks(kind: str, attach: Callable) -> None:
+    """Register ``attach(sim)`` run by every :class:`~mpm_warp.Simulation` of scene kind ``kind``."""
+    SCENE_HOOKS[kind] = attach
+
+
+def attach_scene(sim) -> None:
+    """Run the registered hooks of the simulation's scene kind (no-op for plain block scenes)."""
+    kind = (sim.scenario.scene or {}).get("kind", "blocks")
+    hook = SCENE_HOOKS.get(kind)
+    if hook is not None:
+        hook(sim)
 
 
 def expand_scene(raw: dict, source: str = "scenario") -> dict:
@@ -41,3 +58,4 @@ def expand_scene(raw: dict, source: str = "scenario") -> dict:
         known = ", ".join(["blocks", *sorted(SCENE_BUILDERS)])
         raise ScenarioError(f"{source}: scene.kind = {kind!r} is unknown; known: {known}")
     return SCENE_BUILDERS[kind](raw)
+from . import pst, shear_test  # noqa: F401
