@@ -203,7 +203,8 @@ class RunWriter:
                                   "scalars, static fields and 'wall_forces'")
         attrs = dict(attrs or {})
         if _RESERVED_ATTRS & attrs.keys():
-            raise InvalidArgument("attrs", sorted(attrs), f"no reserved key {sorted(_RESERVED_ATTRS)}")
+            raise InvalidArgument("attrs keys", sorted(_RESERVED_ATTRS & attrs.keys()),
+                                  f"none of the reserved keys {sorted(_RESERVED_ATTRS)}")
         if append and os.path.exists(self.path):
             self._f = self._resume(keep_frames, attrs)
         else:
@@ -469,6 +470,14 @@ def checkpoint_path_for(run_path) -> str:
     return (base if ext.lower() in (".h5", ".hdf5", ".hdf") else base + ext) + ".ckpt.h5"
 
 
+def _fsync(path: str) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
 def write_checkpoint(path, arrays: dict[str, np.ndarray], meta: dict) -> None:
     """Write the full state atomically: a temporary file, fsync, then ``os.replace``.
 
@@ -490,22 +499,14 @@ def write_checkpoint(path, arrays: dict[str, np.ndarray], meta: dict) -> None:
                            meta=_to_json(meta))
             for name, a in arrays.items():
                 f.create_dataset(name, data=np.asarray(a))
-        fd = os.open(tmp, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
+        _fsync(tmp)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.remove(tmp)
         raise
-    try:                                      # make the rename itself durable
-        fd = os.open(os.path.dirname(os.path.abspath(path)), os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
+    try:                                      # make the rename durable too
+        _fsync(os.path.dirname(os.path.abspath(path)))
     except OSError:                           # directories cannot be fsynced everywhere
         pass
 
