@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 import time
 
@@ -16,10 +17,41 @@ from .errors import MPMError, SimulationBlowUp
 __all__ = ["main"]
 
 
+class StopRequest:
+    """SIGINT/SIGTERM handler that asks the run to stop at the next frame boundary.
+
+    Python may swallow a KeyboardInterrupt raised inside a callback, so the CLI
+    catches the signals itself; the run then ends after a complete frame and
+    says where its output and checkpoint are. A second signal aborts at once.
+    """
+
+    def __init__(self):
+        self.requested = False
+        self._old = {}
+
+    def __enter__(self):
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc):
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+
+    def _handle(self, signum, frame):
+        if self.requested:
+            raise KeyboardInterrupt
+        self.requested = True
+        sys.stderr.write("\nmpm-warp: stop requested; finishing the current frame (signal again to abort)\n")
+
+
 class Progress:
     """Frame callback printing sim time, steps, speed and ETA on one line (stderr)."""
 
-    def __init__(self, end_time: float, stream=sys.stderr, every: float = 0.5):
+    def __init__(self, end_time: float, stream=sys.stderr, every: float = 0.5, stop: StopRequest | None = None,
+                 quiet: bool = False):
+        self.stop = stop
+        self.quiet = quiet
         self.end = end_time
         self.stream = stream
         self.every = every
@@ -27,6 +59,10 @@ class Progress:
         self.last = 0.0
 
     def __call__(self, sim, frame: int):
+        if self.stop is not None and self.stop.requested:
+            return False
+        if self.quiet:
+            return None
         now = time.perf_counter()
         t = sim.time
         if now - self.last < self.every and t < self.end:
@@ -43,7 +79,8 @@ class Progress:
         return None
 
     def close(self):
-        self.stream.write("\n")
+        if not self.quiet:
+            self.stream.write("\n")
 
 
 def _summary(res, out=sys.stdout):
@@ -62,13 +99,17 @@ def cmd_run(a) -> int:
 
     sc = load_scenario(a.scenario, a.set)
     sim = Simulation(sc, device=a.device)
-    prog = None if a.quiet else Progress(sc.time.end)
-    try:
-        res = sim.run(a.out, callback=prog)
-    finally:
-        if prog:
+    with StopRequest() as stop:
+        prog = Progress(sc.time.end, stop=stop, quiet=a.quiet)
+        try:
+            res = sim.run(a.out, callback=prog)
+        finally:
             prog.close()
     _summary(res)
+    if stop.requested:
+        where = f"; frames so far are in {a.out}, resume with `mpm-warp resume {a.out}`" if a.out else ""
+        print(f"mpm-warp: stopped at t = {res.sim_time:.6g} s on request{where}", file=sys.stderr)
+        return 130
     if a.json:
         print(json.dumps(res.__dict__, default=str))
     return 0

@@ -290,6 +290,8 @@ class Simulation:
                     if ce and self.frame_index % ce == 0:
                         self._checkpoint(ckpt)
                 if callback is not None and callback(self, self.frame_index) is False:
+                    if writer is not None:
+                        self._checkpoint(ckpt)  # a stop on request can be resumed from exactly here
                     break
         except SimulationBlowUp as e:
             e.output = output

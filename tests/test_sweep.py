@@ -17,13 +17,12 @@ import subprocess
 import sys
 import time
 
+import distributed  # noqa: E402,F401  (a test dependency: the sweep tests must run, never skip)
 import numpy as np
 import pytest
 
 import mpm_warp as mw
 from mpm_warp.sweep import _tasks, expand_cases, parse_vary, read_cases, run_sweep, split_values
-
-pytest.importorskip("distributed")
 
 SCENE = "elastic_block"
 TINY = ["time.end=0.02", "time.frame_interval=0.01"]
