@@ -1,0 +1,116 @@
+"""Shared pieces of the benchmarks: the elastic block scene, timing, environment record."""
+
+from __future__ import annotations
+
+import datetime
+import json
+import os
+import platform
+import statistics
+import time
+
+import numpy as np
+import warp as wp
+
+import mpm_warp
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+
+
+def block_scenario(n_grid: int, material=None, boundary: str = "slip", precision: str = "float32",
+                   dt: float = 1e-4) -> mpm_warp.Scenario:
+    """The throughput scene shared with ``taichi_peer.py``.
+
+    Unit box with slip faces three cells in from the grid edge, block
+    ``[0.25, 0.75]^3`` with 8 particles per cell (``n_grid^3`` particles), Hencky
+    elastic E = 1e5 Pa, nu = 0.3, rho = 1000 kg/m^3, gravity, fixed dt = 1e-4 s.
+    """
+    dx = 1.0 / n_grid
+    mat = material or mpm_warp.Elastic(1e5, 0.3, 1000.0)
+    return mpm_warp.Scenario(
+        name=f"block{n_grid}",
+        domain=mpm_warp.Domain((3 * dx,) * 3, (1 - 3 * dx,) * 3, dx, boundary=boundary),
+        time=mpm_warp.TimeControl(end=1.0, frame_interval=1.0, dt=dt),
+        materials={"m": mat},
+        blocks=(mpm_warp.Block("m", (0.25,) * 3, (0.75,) * 3),),
+        precision=precision,
+    )
+
+
+def time_steps(sim: mpm_warp.Simulation, steps: int, repeats: int = 3, warmup: int = 3) -> list[float]:
+    """Seconds per step of ``repeats`` timed batches of ``steps`` steps (kernels compiled beforehand)."""
+    st = sim.stepper
+    st.set_frame_end(1e9)
+    st.steps(warmup)
+    wp.synchronize_device(sim.device)
+    out = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        st.steps(steps)
+        wp.synchronize_device(sim.device)
+        out.append((time.perf_counter() - t0) / steps)
+    return out
+
+
+def stage_times(sim: mpm_warp.Simulation, steps: int = 10) -> dict[str, float]:
+    """Median seconds per step of each stage, launched one stage at a time (one thread)."""
+    st = sim.stepper
+    st.set_frame_end(1e9)
+    acc = {"p2g": [], "grid_update": [], "g2p": []}
+    dev = sim.device
+    for _ in range(steps):
+        st._begin.launch()
+        wp.synchronize_device(dev)
+        t0 = time.perf_counter()
+        for k in range(st.n_threads):
+            st._scatter(k)
+        wp.synchronize_device(dev)
+        t1 = time.perf_counter()
+        for g in st._grid:
+            g.launch()
+        wp.synchronize_device(dev)
+        t2 = time.perf_counter()
+        for g in st._g2p:
+            g.launch()
+        wp.synchronize_device(dev)
+        t3 = time.perf_counter()
+        st._end.launch()
+        acc["p2g"].append(t1 - t0)
+        acc["grid_update"].append(t2 - t1)
+        acc["g2p"].append(t3 - t2)
+    return {k: statistics.median(v) for k, v in acc.items()}
+
+
+def environment(device: str) -> dict:
+    """Device, versions and date of a benchmark run."""
+    import h5py
+
+    env = {
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "device": device,
+        "device_name": wp.get_device(device).name if device else "",
+        "cpu": platform.processor() or platform.machine(),
+        "cpu_count": os.cpu_count(),
+        "python": platform.python_version(),
+        "mpm_warp": mpm_warp.__version__,
+        "warp": wp.config.version,
+        "numpy": np.__version__,
+        "h5py": h5py.__version__,
+    }
+    try:
+        import importlib.metadata as md
+
+        env["taichi"] = md.version("taichi")
+    except Exception:  # noqa: BLE001 - optional
+        env["taichi"] = None
+    return env
+
+
+def write_json(name: str, data: dict) -> str:
+    """Write ``benchmarks/results/<name>.json``; return its path."""
+    os.makedirs(RESULTS, exist_ok=True)
+    path = os.path.join(RESULTS, name + ".json")
+    with open(path, "w") as fh:
+        json.dump(data, fh, indent=1, default=float)
+        fh.write("\n")
+    return path
