@@ -266,6 +266,8 @@ class Simulation:
                 writer = self._open_writer(output)
                 self._write_frame(writer)
                 self._checkpoint(ckpt)
+        elif not append:
+            self._frame_diagnostics()
         self._last_frame_time = self.time
         # warm up: compile every kernel before timing
         self._compile()
@@ -289,6 +291,8 @@ class Simulation:
                     ce = self.scenario.output.checkpoint_every
                     if ce and self.frame_index % ce == 0:
                         self._checkpoint(ckpt)
+                else:
+                    self._frame_diagnostics()
                 if callback is not None and callback(self, self.frame_index) is False:
                     if writer is not None:
                         self._checkpoint(ckpt)  # a stop on request can be resumed from exactly here
@@ -345,14 +349,20 @@ class Simulation:
         t, _, steps = self.stepper.clock()
         parts = {name: self.particle_field(name) for name in self.scenario.output.fields}
         scalars = self.energies()
-        for f in self.frame_diagnostics:
-            scalars.update(f(self))
+        scalars.update(self._frame_diagnostics())
         imp = self.stepper.take_wall_impulse()
         # mean force over the frame just ended (its real duration: the last frame may be short)
         span = t - getattr(self, "_last_frame_time", t)
         self._last_frame_time = t
         forces = (imp / span if span > 0 else np.zeros_like(imp)) if len(imp) else None
         writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
+
+    def _frame_diagnostics(self) -> dict:
+        """Evaluate the scene's frame diagnostics (also without an output file: they may record series)."""
+        out = {}
+        for f in self.frame_diagnostics:
+            out.update(f(self))
+        return out
 
     def _checkpoint(self, path: str | None) -> None:
         if path is None:
