@@ -39,6 +39,7 @@ def register_scene_hooks(kind: str, attach: Callable) -> None:
 def attach_scene(sim) -> None:
     """Run the registered hooks of the simulation's scene kind (no-op for plain block scenes)."""
     kind = (sim.scenario.scene or {}).get("kind", "blocks")
+    _load_builtin_scenes()
     hook = SCENE_HOOKS.get(kind)
     if hook is not None:
         hook(sim)
@@ -54,8 +55,13 @@ def expand_scene(raw: dict, source: str = "scenario") -> dict:
     kind = scene.get("kind", "blocks")
     if kind == "blocks":
         return raw
+    _load_builtin_scenes()
     if kind not in SCENE_BUILDERS:
         known = ", ".join(["blocks", *sorted(SCENE_BUILDERS)])
         raise ScenarioError(f"{source}: scene.kind = {kind!r} is unknown; known: {known}")
     return SCENE_BUILDERS[kind](raw)
-from . import pst, shear_test  # noqa: F401
+
+
+def _load_builtin_scenes() -> None:
+    """Import the scene modules shipped with the library (they register themselves)."""
+    from . import pst, shear_test  # noqa: F401
