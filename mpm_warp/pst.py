@@ -556,26 +556,13 @@ def run_pst(scenario, output: str | None = None, device: str | None = None, over
     -------
     (RunResult, PSTMonitor)
     """
-    from .scenario import Scenario, load_scenario
-    from .simulation import Simulation
+    from .scenes import run_scene
 
-    if not isinstance(scenario, Scenario):
-        scenario = load_scenario(str(scenario), overrides)
-    sim = Simulation(scenario, device=device, n_threads=n_threads)  # the scene hook attaches the monitor
-    res = sim.run(output, **run_kwargs)
-    return res, sim.scene_monitor
-
-
-def attach_scene(sim) -> None:
-    """Scene hook: every Simulation of this kind gets its device actions, frame series and summary."""
-    mon = attach(sim)
-    if not getattr(mon, "_summary_hooked", False):
-        sim.result_hooks.append(lambda s: mon.summary())
-        mon._summary_hooked = True
+    return run_scene(scenario, output, device, overrides, n_threads, **run_kwargs)
 
 
 # registered last: mpm_warp.scenes imports this module lazily (no circular import at load time)
-from .scenes import register_scene, register_scene_hooks  # noqa: E402
+from .scenes import register_scene, register_scene_monitor  # noqa: E402
 
 register_scene("pst")(build_pst)
-register_scene_hooks("pst", attach_scene)
+register_scene_monitor("pst", attach)

@@ -12,8 +12,8 @@ from collections.abc import Callable
 
 from .errors import ScenarioError
 
-__all__ = ["register_scene", "register_scene_hooks", "expand_scene", "attach_scene", "SCENE_BUILDERS",
-           "SCENE_HOOKS"]
+__all__ = ["register_scene", "register_scene_hooks", "register_scene_monitor", "run_scene", "expand_scene",
+           "attach_scene", "SCENE_BUILDERS", "SCENE_HOOKS"]
 
 SCENE_BUILDERS: dict[str, Callable[[dict], dict]] = {}
 #: scene kind -> ``attach(sim)``: adds the scene's device actions (``sim.stepper.actions``), frame
@@ -34,6 +34,34 @@ def register_scene(kind: str):
 def register_scene_hooks(kind: str, attach: Callable) -> None:
     """Register ``attach(sim)`` run by every :class:`~mpm_warp.Simulation` of scene kind ``kind``."""
     SCENE_HOOKS[kind] = attach
+
+
+def register_scene_monitor(kind: str, attach: Callable) -> None:
+    """Register ``attach(sim) -> monitor`` for ``kind``; the monitor's ``summary()`` goes into ``RunResult.extra``."""
+
+    def hook(sim):
+        mon = attach(sim)
+        if not getattr(mon, "_summary_hooked", False):
+            sim.result_hooks.append(lambda s: mon.summary())
+            mon._summary_hooked = True
+
+    SCENE_HOOKS[kind] = hook
+
+
+def run_scene(scenario, output=None, device=None, overrides=None, n_threads=None, **run_kwargs):
+    """Load (name, path or Scenario) and run a scene; return ``(RunResult, sim.scene_monitor)``.
+
+    The scene's hooks attach its device actions and diagnostics, so this is
+    ``mpm_warp.run`` that also hands back the scene's monitor (series, summary).
+    """
+    from .scenario import Scenario, load_scenario
+    from .simulation import Simulation
+
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(str(scenario), overrides)
+    sim = Simulation(scenario, device=device, n_threads=n_threads)
+    res = sim.run(output, **run_kwargs)
+    return res, getattr(sim, "scene_monitor", None)
 
 
 def attach_scene(sim) -> None:
