@@ -6,7 +6,7 @@ derives from :class:`MPMError`, so callers can catch them all at once.
 
 from __future__ import annotations
 
-__all__ = ["MPMError", "InvalidArgument", "ScenarioError", "SimulationBlowUp", "OutputError"]
+__all__ = ["MPMError", "InvalidArgument", "ScenarioError", "SimulationBlowUp", "OutputError", "RenderingUnavailable"]
 
 
 class MPMError(Exception):
@@ -61,6 +61,10 @@ class SimulationBlowUp(MPMError, RuntimeError):
         if checkpoint:
             msg += f"; last good checkpoint {checkpoint} (resume with `mpm-warp resume`)"
         super().__init__(msg)
+
+
+class RenderingUnavailable(MPMError, RuntimeError):
+    """No OpenGL back end for off-screen rendering (or no encoder for the film) on this machine."""
 
 
 class OutputError(MPMError, OSError):

@@ -24,7 +24,7 @@ import sys
 
 import numpy as np
 
-from .errors import InvalidArgument, MPMError
+from .errors import InvalidArgument, RenderingUnavailable
 from .io import read_run
 
 __all__ = ["FIELDS", "CAMERAS", "RenderingUnavailable", "Rendered", "render_run", "parse_frames",
@@ -43,10 +43,6 @@ CAMERAS = ("auto", "side", "oblique")
 FRONT_COLOR = (255, 0, 255)              # magenta: absent from the viridis colour map
 BELOW_COLOR = (190, 190, 190)            # particles below the colour range (e.g. a sawn weak layer)
 _CMAP = "viridis"
-
-
-class RenderingUnavailable(MPMError, RuntimeError):
-    """No OpenGL back end for off-screen rendering (or no encoder for the film) on this machine."""
 
 
 def _has_lib(name: str) -> bool:
