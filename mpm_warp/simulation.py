@@ -216,6 +216,8 @@ class Simulation:
             if dt <= 0:
                 dt = self._first_dt()
             n = max(1, min(he, int(math.ceil((t_end - t) / dt))))
+            if self.stepper.use_graph:
+                n = self.stepper.graph_batch  # one captured graph; the steps past t_end are no-ops (dt = 0)
             self.stepper.steps(n)
             t, dt_new, steps = self.stepper.clock()
             taken = steps - steps0

@@ -139,7 +139,9 @@ class Stepper:
                 device=dev, record_cmd=True))
         self._end = wp.launch(end_step_kernel(), 1, inputs=[s.clock, s.steps], device=dev, record_cmd=True)
         self.use_graph = wp.get_device(dev).is_cuda if use_graph is None else use_graph
-        self._graphs: dict[int, object] = {}
+        self._graph = None
+        #: steps per captured CUDA graph (the driver asks for whole batches; steps past a frame end are no-ops)
+        self.graph_batch = max(1, model.scenario.output.health_every)
         self._pool = ThreadPoolExecutor(nt, thread_name_prefix="mpm_warp") if nt > 1 else None
         #: recorded launches (``.launch()``) run at the start of every step, after the step size is set
         #: (e.g. a saw advancing through a weak layer); add them before the first call of :meth:`steps`.
@@ -176,22 +178,23 @@ class Stepper:
     def steps(self, n: int) -> None:
         """Launch ``n`` steps without any host synchronisation.
 
-        On CUDA with ``use_graph`` the batch is captured once per batch size and
-        replayed; otherwise launches are eager. Both give the same answer.
+        On CUDA with ``use_graph`` one graph of :attr:`graph_batch` steps is
+        captured once and replayed ``n // graph_batch`` times; the remainder runs
+        eagerly. Both give the same answer.
         """
         if n <= 0:
             return
         if self.use_graph:
-            graph = self._graphs.get(n)
-            if graph is None:
+            if self._graph is None:
                 with wp.ScopedCapture(device=self.model.device) as cap:
-                    for _ in range(n):
+                    for _ in range(self.graph_batch):
                         self._launch_step()
-                graph = self._graphs[n] = cap.graph
-            wp.capture_launch(graph)
-        else:
-            for _ in range(n):
-                self._launch_step()
+                self._graph = cap.graph
+            for _ in range(n // self.graph_batch):
+                wp.capture_launch(self._graph)
+            n = n % self.graph_batch
+        for _ in range(n):
+            self._launch_step()
 
     def seed_vmax(self) -> None:
         """Set the speed bound of the next step from the particles' current speeds.
