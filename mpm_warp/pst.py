@@ -54,7 +54,6 @@ the saw/front action and the frame diagnostics to a :class:`Simulation`, and
 
 
 import copy
-import functools
 import math
 
 import numpy as np
@@ -62,11 +61,10 @@ import warp as wp
 
 from . import fronts
 from .errors import ScenarioError
-from .kernels.camclay import camclay_p0_func, camclay_pq_func, camclay_yield_func
-from .kernels.types import mat33, vec3
+from .kernels.snow import pst_action_kernel, weak_layer_kernel
 from .validate import finite_number
 
-__all__ = ["build_pst", "attach", "run_pst", "PSTMonitor", "pst_action_kernel", "slab_normal_stress",
+__all__ = ["build_pst", "attach", "run_pst", "PSTMonitor", "slab_normal_stress",
            "weak_layer_material", "GRAVITY"]
 
 GRAVITY = fronts.GRAVITY
@@ -274,58 +272,6 @@ def build_pst(raw: dict) -> dict:
 
 
 # ----------------------------------------------------------------------------- device actions
-@functools.cache
-def weak_layer_kernel(T):
-    """Weak-layer bookkeeping and brittle cohesion loss, one thread per weak-layer particle, every step.
-
-    ``ref`` is the hardening state collapse is measured from: a copy of
-    ``log_jp`` until ``t_ref`` (the settled layer), then fixed. ``failed`` is 0
-    (intact), 1 (failed) or 2 (sawn, see :func:`pst_action_kernel`).
-
-    With ``brittle != 0``, from ``t_ref`` on, an intact particle whose stress
-    has reached the yield surface (``y >= -tol M^2 a^2``, ``a = p0 (1 + beta)/2``;
-    shear, tension or compression: MODEL.md 2) loses its cohesion at once:
-    ``log_jp = max(log_jp, log_jp_failed)`` (0: ``p0`` at its floor), ``failed = 1``
-    and ``ref`` is reset to that state. The engine's Cam-Clay return then
-    compacts it under the slab load until the hardening law carries the load
-    again: the collapse of the anticrack, ``1 - J_P = 1 - exp(-asinh(p/K)/xi)``
-    on the cap. A particle fails once; before ``t_ref`` (settling) only the
-    engine's model acts.
-    Stress from the SVD of ``F_E`` (Hencky, Kirchhoff, Pa).
-    """
-    V = vec3(T)
-    M33 = mat33(T)
-    pq = camclay_pq_func(T)
-    p0_fn = camclay_p0_func(T)
-    yield_fn = camclay_yield_func(T)
-
-    @wp.kernel(enable_backward=False)
-    def weak_layer(F: wp.array(dtype=M33), log_jp: wp.array(dtype=T), ref: wp.array(dtype=T),
-                   failed: wp.array(dtype=wp.uint8), clock: wp.array(dtype=wp.float64), t_ref: wp.float64,
-                   brittle: wp.int32, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T, log_jp_failed: T,
-                   tol: T):
-        i = wp.tid()
-        lj = log_jp[i]
-        if brittle != 0 and failed[i] == wp.uint8(0) and clock[0] >= t_ref:
-            U = M33()
-            sig = V()
-            Vt = M33()
-            wp.svd3(F[i], U, sig, Vt)
-            p, q = pq(sig, mu, lam)
-            K = lam + T(2.0) / T(3.0) * mu
-            p0 = p0_fn(lj, K, xi, p0_floor)
-            a = T(0.5) * p0 * (T(1.0) + beta)
-            if yield_fn(p, q, p0, M, beta) >= -tol * M * M * a * a:
-                failed[i] = wp.uint8(1)
-                lj = wp.max(lj, log_jp_failed)
-                log_jp[i] = lj
-                ref[i] = lj
-        if clock[0] < t_ref and failed[i] == wp.uint8(0):
-            ref[i] = lj
-
-    return weak_layer
-
-
 class WeakLayer:
     """Device state of a Cam-Clay weak layer group: collapse reference, failure flags, brittle action.
 
@@ -373,46 +319,6 @@ class WeakLayer:
         """Host copies: collapse ``1 - exp(log_jp - ref)`` (-) and the failure flags."""
         lj = self.log_jp.numpy().astype(np.float64)
         return fronts.collapse_fraction(lj, self.ref.numpy().astype(np.float64)), self.failed.numpy()
-
-
-@functools.cache
-def pst_action_kernel(T):
-    """Saw and crack-front tracker, one thread per weak-layer particle, every step.
-
-    From ``t_start`` the blade sits at distance ``min(speed (t - t_start),
-    cut_length)`` from ``x_start`` along ``direction`` (+1 or -1); particles
-    behind it get ``log_jp = max(log_jp, log_jp_cut)`` and ``failed = 2``.
-    ``arrival_collapse[bin]`` (s) receives the first time one of the bin's
-    particles was sawn or collapsed (``log_jp - ref <= collapse_log``, i.e.
-    ``1 - J_P/J_P,ref >= threshold``); ``arrival_failure[bin]`` the first time one
-    was sawn or failed. Times are the step's start ``clock[0]`` (float64, s).
-    """
-    V = vec3(T)
-
-    @wp.kernel(enable_backward=False)
-    def pst_action(x: wp.array(dtype=V), log_jp: wp.array(dtype=T), ref: wp.array(dtype=T),
-                   failed: wp.array(dtype=wp.uint8), clock: wp.array(dtype=wp.float64), t_start: wp.float64,
-                   x_start: wp.float64, direction: wp.float64, speed: wp.float64, cut_length: wp.float64,
-                   log_jp_cut: T, collapse_log: T, bin_width: wp.float64,
-                   arrival_collapse: wp.array(dtype=wp.float64), arrival_failure: wp.array(dtype=wp.float64)):
-        i = wp.tid()
-        t = clock[0]
-        if t < t_start:
-            return
-        lj = log_jp[i]
-        s = (wp.float64(x[i][0]) - x_start) * direction
-        if s <= wp.min(speed * (t - t_start), cut_length):
-            log_jp[i] = wp.max(lj, log_jp_cut)
-            failed[i] = wp.uint8(2)
-        f = failed[i]
-        b = int(wp.floor(s / bin_width))
-        if b >= 0 and b < arrival_collapse.shape[0]:
-            if f != wp.uint8(0):
-                wp.atomic_min(arrival_failure, b, t)
-            if f == wp.uint8(2) or lj - ref[i] <= collapse_log:
-                wp.atomic_min(arrival_collapse, b, t)
-
-    return pst_action
 
 
 class PSTMonitor:

@@ -8,8 +8,9 @@ import warp as wp
 
 from mpm_warp import read_run
 from mpm_warp.errors import ScenarioError
+from mpm_warp.kernels.snow import pst_action_kernel, weak_layer_kernel
 from mpm_warp.kernels.types import mat33, vec3
-from mpm_warp.pst import pst_action_kernel, run_pst, weak_layer_kernel
+from mpm_warp.pst import run_pst
 from mpm_warp.scenario import load_scenario
 
 DEVICE = "cpu"
