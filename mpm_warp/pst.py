@@ -431,23 +431,10 @@ class PSTMonitor:
 
 
 def attach(sim) -> PSTMonitor:
-    """Add the saw/front action and the PST frame diagnostics to ``sim``; return the monitor.
+    """Add the saw/front action and the PST frame diagnostics to ``sim``; return the monitor (idempotent)."""
+    from .scenes import attach_monitor
 
-    Idempotent: a simulation that already has one (``sim.scene_monitor``, set here, or
-    by the engine's scene-runtime hook when it exists) gets it back unchanged.
-    """
-    prev = getattr(sim, "scene_monitor", None)
-    if isinstance(prev, PSTMonitor):
-        return prev
-    mon = PSTMonitor(sim)
-    sim.scene_monitor = mon
-
-    def pst_diagnostics(s):
-        return mon.frame_scalars(s)
-
-    pst_diagnostics.units = mon.units()
-    sim.frame_diagnostics.append(pst_diagnostics)
-    return mon
+    return attach_monitor(sim, PSTMonitor)
 
 
 #: former name of :func:`mpm_warp.fronts.pst_summary`

@@ -12,8 +12,8 @@ from collections.abc import Callable
 
 from .errors import ScenarioError
 
-__all__ = ["register_scene", "register_scene_hooks", "register_scene_monitor", "run_scene", "expand_scene",
-           "attach_scene", "SCENE_BUILDERS", "SCENE_HOOKS"]
+__all__ = ["register_scene", "register_scene_hooks", "register_scene_monitor", "attach_monitor", "run_scene",
+           "expand_scene", "attach_scene", "SCENE_BUILDERS", "SCENE_HOOKS"]
 
 SCENE_BUILDERS: dict[str, Callable[[dict], dict]] = {}
 #: scene kind -> ``attach(sim)``: adds the scene's device actions (``sim.stepper.actions``), frame
@@ -34,6 +34,27 @@ def register_scene(kind: str):
 def register_scene_hooks(kind: str, attach: Callable) -> None:
     """Register ``attach(sim)`` run by every :class:`~mpm_warp.Simulation` of scene kind ``kind``."""
     SCENE_HOOKS[kind] = attach
+
+
+def attach_monitor(sim, monitor_cls):
+    """Give ``sim`` one scene monitor of ``monitor_cls`` (idempotent) and record its frame series.
+
+    The monitor is built with ``monitor_cls(sim)`` (it adds its device actions),
+    kept as ``sim.scene_monitor``, and its ``frame_scalars(sim)`` with ``units()``
+    join the simulation's frame diagnostics.
+    """
+    prev = getattr(sim, "scene_monitor", None)
+    if isinstance(prev, monitor_cls):
+        return prev
+    mon = monitor_cls(sim)
+    sim.scene_monitor = mon
+
+    def diagnostics(s):
+        return mon.frame_scalars(s)
+
+    diagnostics.units = mon.units()
+    sim.frame_diagnostics.append(diagnostics)
+    return mon
 
 
 def register_scene_monitor(kind: str, attach: Callable) -> None:

@@ -135,6 +135,10 @@ class ShearMonitor:
              "layer_shear_stress": "Pa",
              "shear_stress": "Pa", "mises_q": "Pa", "p_mean": "Pa", "collapse": "1", "failed_fraction": "1"}
 
+    def units(self) -> dict[str, str]:
+        """Units of the frame series this monitor records."""
+        return dict(self.UNITS)
+
     def __init__(self, sim):
         scene = sim.scenario.scene
         if scene.get("kind") != "shear_test" or "derived" not in scene:
@@ -195,23 +199,10 @@ class ShearMonitor:
 
 
 def attach(sim) -> ShearMonitor:
-    """Add the weak-layer action and the shear-test frame diagnostics to ``sim``; return the monitor.
+    """Add the weak-layer action and the shear-test frame diagnostics to ``sim``; return the monitor (idempotent)."""
+    from .scenes import attach_monitor
 
-    Idempotent: a simulation that already has one (``sim.scene_monitor``, set here, or
-    by the engine's scene-runtime hook when it exists) gets it back unchanged.
-    """
-    prev = getattr(sim, "scene_monitor", None)
-    if isinstance(prev, ShearMonitor):
-        return prev
-    mon = ShearMonitor(sim)
-    sim.scene_monitor = mon
-
-    def shear_diagnostics(s):
-        return mon.frame_scalars(s)
-
-    shear_diagnostics.units = dict(ShearMonitor.UNITS)
-    sim.frame_diagnostics.append(shear_diagnostics)
-    return mon
+    return attach_monitor(sim, ShearMonitor)
 
 
 def shear_curves(scene: dict, times, series: dict) -> dict[str, np.ndarray]:
