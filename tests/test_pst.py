@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 import warp as wp
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 from mpm_warp import read_run
 from mpm_warp.errors import ScenarioError
@@ -13,7 +14,6 @@ from mpm_warp.kernels.types import mat33, vec3
 from mpm_warp.pst import run_pst
 from mpm_warp.scenario import load_scenario
 
-DEVICE = "cpu"
 G = 9.81
 
 

@@ -7,6 +7,7 @@ import sys
 import time
 
 import numpy as np
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
 from mpm_warp import io
@@ -16,7 +17,7 @@ TINY = ["time.end=0.06", "time.frame_interval=0.01", "output.checkpoint_every=2"
 
 def _run(path, overrides=TINY):
     sc = mw.load_scenario("elastic_block", overrides)
-    return mw.Simulation(sc, device="cpu").run(str(path))
+    return mw.Simulation(sc, device=DEVICE).run(str(path))
 
 
 def test_resumed_run_matches_uninterrupted_bit_for_bit(tmp_path):
@@ -25,9 +26,9 @@ def test_resumed_run_matches_uninterrupted_bit_for_bit(tmp_path):
     # the same run stopped after frame 3 (a checkpoint exists at frame 2), then resumed
     part = tmp_path / "part.h5"
     sc = mw.load_scenario("elastic_block", TINY)
-    mw.Simulation(sc, device="cpu").run(str(part), callback=lambda sim, k: k < 3)
+    mw.Simulation(sc, device=DEVICE).run(str(part), callback=lambda sim, k: k < 3)
     assert mw.read_run(str(part)).n_frames == 4  # frames 0..3
-    res = mw.resume(str(part), device="cpu")
+    res = mw.resume(str(part), device=DEVICE)
     a, b = mw.read_run(str(full)), mw.read_run(str(part))
     assert a.n_frames == b.n_frames == 7
     np.testing.assert_array_equal(a.times, b.times)
@@ -54,7 +55,8 @@ def test_cli_interrupted_by_signal_keeps_frames_and_resumes(tmp_path):
     """A real `mpm-warp run` gets SIGINT mid-run: it stops after a complete frame, exit 130, and resumes."""
     out = tmp_path / "cli.h5"
     cmd = [sys.executable, "-m", "mpm_warp.cli", "run", "elastic_block", "--out", str(out), "--quiet",
-           "--set", "time.end=0.3", "--set", "time.frame_interval=0.005", "--set", "output.checkpoint_every=50"]
+           "--set", "time.end=0.3", "--set", "time.frame_interval=0.005", "--set", "output.checkpoint_every=50",
+           "--device", DEVICE]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.time() + 120
     while time.time() < deadline:
@@ -72,7 +74,8 @@ def test_cli_interrupted_by_signal_keeps_frames_and_resumes(tmp_path):
     run = mw.read_run(str(out))
     assert 3 <= run.n_frames < 61
     assert os.path.exists(io.checkpoint_path_for(str(out)))
-    res = subprocess.run([sys.executable, "-m", "mpm_warp.cli", "resume", str(out)], capture_output=True, text=True,
+    res = subprocess.run([sys.executable, "-m", "mpm_warp.cli", "resume", str(out), "--device", DEVICE],
+                         capture_output=True, text=True,
                          timeout=300)
     assert res.returncode == 0, res.stderr
     run = mw.read_run(str(out))

@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 from mpm_warp.errors import ScenarioError
 from mpm_warp.scenario import load_scenario
 from mpm_warp.shear_test import run_shear_test, shear_curves
 
-DEVICE = "cpu"
 G = 9.81
 
 

@@ -11,12 +11,12 @@ import math
 
 import numpy as np
 import pytest
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
 from mpm_warp.io import checkpoint_path_for, read_checkpoint
 from mpm_warp.model import SINGULAR_VALUE_FLOOR
 
-DEVICE = "cpu"
 G = 9.81
 
 
