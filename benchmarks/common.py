@@ -85,10 +85,14 @@ def environment(device: str) -> dict:
     """Device, versions and date of a benchmark run."""
     import h5py
 
+    dev = wp.get_device(device) if device else None
     env = {
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "device": device,
-        "device_name": wp.get_device(device).name if device else "",
+        "device_name": dev.name if dev is not None else "",
+        "cuda_driver": _version_str(wp.get_cuda_driver_version()) if dev is not None and dev.is_cuda else None,
+        "cuda_toolkit": _version_str(wp.get_cuda_toolkit_version()) if dev is not None and dev.is_cuda else None,
+        "load_average_1_5_15_min": list(os.getloadavg()),
         "cpu": platform.processor() or platform.machine(),
         "cpu_count": os.cpu_count(),
         "python": platform.python_version(),
@@ -106,10 +110,21 @@ def environment(device: str) -> dict:
     return env
 
 
-def write_json(name: str, data: dict) -> str:
-    """Write ``benchmarks/results/<name>.json``; return its path."""
-    os.makedirs(RESULTS, exist_ok=True)
-    path = os.path.join(RESULTS, name + ".json")
+def _version_str(v) -> str | None:
+    return ".".join(str(p) for p in v) if v else None
+
+
+def write_json(name: str, data: dict, results_dir: str | None = None) -> str:
+    """Write ``<results_dir or benchmarks/results>/<name>.json``; return its path.
+
+    When ``data`` has an ``environment`` the load average at writing time is
+    added beside the one at the start (how busy the shared machine was).
+    """
+    if isinstance(data.get("environment"), dict):
+        data["environment"]["load_average_at_end_1_5_15_min"] = list(os.getloadavg())
+    results_dir = results_dir or RESULTS
+    os.makedirs(results_dir, exist_ok=True)
+    path = os.path.join(results_dir, name + ".json")
     with open(path, "w") as fh:
         json.dump(data, fh, indent=1, default=float)
         fh.write("\n")

@@ -1,0 +1,114 @@
+"""The plastic step beside Taichi: the struck Cam-Clay block of ``plastic_block`` in both engines.
+
+Usage: ``python benchmarks/plastic_step.py [--n-grid 32 48 64] [--steps 50] [--threads 1] [--device cpu]``.
+Writes ``benchmarks/results/plastic_step_<device>.json``.
+
+For every size both engines run the same scene with the same protocol
+(``warp_block`` / ``taichi_peer``: compiled, warmed up to yield, median of
+``--repeats`` repeats of ``--steps`` steps from one snapshot; Taichi in its own
+process). Each row records:
+
+* particle-steps/s of both and their ratio;
+* the return kinds of every timed step in both engines (fraction yielding, cap
+  and dry-side returns), checked against ``plastic_block.check_return_kinds``;
+* the observables after the same steps (mean p, mean q, mean log_Jp, mean
+  |log_Jp - log_Jp(0)|) and whether they agree within :data:`AGREEMENT`;
+* where the time goes: mpm_warp per stage (one thread), its step with
+  plasticity compiled out (an elastic material of the same E, nu, rho on the
+  same state), and the SVD and the return alone on the step's trial states
+  (``return_cost``); Taichi's step with the return compiled out (SVD kept).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import plastic_block as pb  # noqa: E402
+import warp_block  # noqa: E402
+from common import environment, write_json  # noqa: E402
+from return_cost import return_cost  # noqa: E402
+from taichi_peer import run_taichi_block_subprocess  # noqa: E402
+
+#: Largest allowed engine difference of each observable, as a fraction of its scale: mean p and mean q
+#: against p0_ini (3.7 Pa: the two engines take different float32 paths, series or SVD strain and a
+#: corrected or rebuilt F_E, and one float32 unit of strain is 0.05 Pa of pressure, summed over ~100
+#: steps of returns), log_Jp against the mean plastic volume change.
+AGREEMENT = 1.0e-3
+
+
+def agreement(a: dict, b: dict) -> dict:
+    """Scaled differences of the observables of two engines and whether all are within :data:`AGREEMENT`."""
+    scale = {"mean_p": pb.P0_INI, "mean_q": pb.P0_INI,
+             "mean_log_jp": max(a["mean_abs_dlog_jp"], 1e-12), "mean_abs_dlog_jp": max(a["mean_abs_dlog_jp"], 1e-12)}
+    diff = {k: abs(a[k] - b[k]) / scale[k] for k in scale}
+    return {"scaled_differences": diff, "tolerance": AGREEMENT, "agree": all(d <= AGREEMENT for d in diff.values())}
+
+
+def compare_size(n_grid: int, steps: int, threads: int, device: str, repeats: int, taichi: bool) -> dict:
+    """One size: mpm_warp and Taichi rows, ratio, agreement and where the time goes."""
+    dim = 3
+    w = warp_block.run_block(dim, "plastic", n_grid, steps, device=device, n_threads=threads, repeats=repeats,
+                             stages=True, diagnostics=True, return_share=True)
+    sim = warp_block.block_simulation(dim, "plastic", n_grid, device, n_threads=1)
+    sim.stepper.set_frame_end(1e9)
+    sim.stepper.steps(w["warmup"])
+    cost = return_cost(sim)
+    w["svd_only_s_per_step"] = cost["trial_svd_s"]
+    w["return_only_s_per_step"] = cost["return_s"]
+    w["return_share"] = cost["return_s"] / w["s_per_step"]
+    w["svd_share"] = cost["trial_svd_s"] / w["s_per_step"]
+    out = {"n_grid": n_grid, "n_particles": w["n_particles"], "threads": threads, "mpm_warp": w}
+    print(f"mpm_warp N {w['n_particles']:7d} threads {w['threads']}: {w['particle_steps_per_s'] / 1e6:6.3f} "
+          f"M particle-steps/s; plasticity share {w['plasticity_share']:.2f}, return alone {w['return_share']:.2f}, "
+          f"SVD alone {w['svd_share']:.2f}; min yielded {min(k['yielded'] for k in w['return_kinds']):.3f}",
+          flush=True)
+    if not taichi:
+        return out
+    arch = "cuda" if device.startswith("cuda") else "cpu"
+    t, err = run_taichi_block_subprocess(n_grid, steps, arch=arch, cpu_max_num_threads=None if arch == "cuda"
+                                         else threads, repeats=repeats, dim=dim, material="plastic",
+                                         warmup=w["warmup"], diagnostics=True, return_share=True)
+    if t is None:
+        out["taichi"] = {"error": err}
+        print("taichi unavailable:", err, flush=True)
+        return out
+    out["taichi"] = t
+    out["ratio_vs_taichi"] = w["particle_steps_per_s"] / t["particle_steps_per_s"]
+    out["agreement"] = agreement(w["observables"], t["observables"])
+    print(f"taichi   N {t['n_particles']:7d} threads {t['threads']}: {t['particle_steps_per_s'] / 1e6:6.3f} "
+          f"M particle-steps/s ({t['p2g_scatter']}); return share {t['return_share']:.2f} -> warp/taichi "
+          f"{out['ratio_vs_taichi']:.2f}; observables agree: {out['agreement']['agree']}", flush=True)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--device", default="cpu")
+    ap.add_argument("--n-grid", type=int, nargs="+", default=[32, 48, 64])
+    ap.add_argument("--steps", type=int, default=50)
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--no-taichi", action="store_true")
+    ap.add_argument("--name", default=None, help="result file name (default plastic_step_<device>)")
+    a = ap.parse_args(argv)
+    env = environment(a.device)
+    rows = [compare_size(n, a.steps, a.threads, a.device, a.repeats, not a.no_taichi) for n in a.n_grid]
+    ratios = [r["ratio_vs_taichi"] for r in rows if "ratio_vs_taichi" in r]
+    out = {"benchmark": "plastic step beside Taichi: struck Cam-Clay snow block (plastic_block.py), 3D, float32",
+           "scene": {"material": {"E": pb.YOUNG_E, "nu": pb.POISSON_NU, "density": pb.DENSITY, "M": pb.M_CSL,
+                                  "beta": pb.BETA, "xi": pb.XI, "p0_ini": pb.P0_INI},
+                     "impact_speed": pb.IMPACT_SPEED, "strain_rate": pb.strain_rate(), "cfl": pb.CFL},
+           "environment": env, "steps": a.steps, "repeats": a.repeats, "rows": rows,
+           "median_ratio_vs_taichi": statistics.median(ratios) if ratios else None}
+    name = a.name or f"plastic_step_{'cuda' if a.device.startswith('cuda') else 'cpu'}"
+    print("wrote", write_json(name, out))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
