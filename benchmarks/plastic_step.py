@@ -26,6 +26,8 @@ import os
 import statistics
 import sys
 
+import numpy as np
+
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import plastic_block as pb  # noqa: E402
@@ -58,10 +60,18 @@ def compare_size(n_grid: int, steps: int, threads: int, device: str, repeats: in
     sim.stepper.set_frame_end(1e9)
     sim.stepper.steps(w["warmup"])
     cost = return_cost(sim)
+    sim.stepper.steps(1)  # the engine's own update of F_E and log_Jp from the same state
     w["svd_only_s_per_step"] = cost["trial_svd_s"]
     w["return_only_s_per_step"] = cost["return_s"]
+    w["series_check_s_per_step"] = cost["series_check_s"]
     w["return_share"] = cost["return_s"] / w["s_per_step"]
     w["svd_share"] = cost["trial_svd_s"] / w["s_per_step"]
+    w["series_check_share"] = cost["series_check_s"] / w["s_per_step"]
+    w["svd_free_prototype"] = {
+        "s_per_step": cost["svd_free_update_s"],
+        "max_abs_F_difference_vs_engine": float(np.abs(cost["svd_free_F"] - sim.state.F.numpy()).max()),
+        "max_abs_log_jp_difference_vs_engine": float(np.abs(cost["svd_free_log_jp"] - sim.state.log_jp.numpy()).max()),
+        "replaces_s_per_step": cost["series_check_s"] + cost["trial_svd_s"] + cost["return_s"]}
     out = {"n_grid": n_grid, "n_particles": w["n_particles"], "threads": threads, "mpm_warp": w}
     print(f"mpm_warp N {w['n_particles']:7d} threads {w['threads']}: {w['particle_steps_per_s'] / 1e6:6.3f} "
           f"M particle-steps/s; plasticity share {w['plasticity_share']:.2f}, return alone {w['return_share']:.2f}, "
