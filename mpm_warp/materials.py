@@ -11,7 +11,18 @@ from dataclasses import asdict, dataclass, field
 
 from .validate import finite_number
 
-__all__ = ["Elastic", "CamClaySnow", "Material", "material_from_dict", "MATERIAL_MODELS"]
+__all__ = ["Elastic", "CamClaySnow", "Material", "material_from_dict", "MATERIAL_MODELS", "lame_parameters"]
+
+
+def lame_parameters(E: float, nu: float) -> tuple[float, float, float]:
+    """Return ``(mu, lam, K)`` (Pa) from Young's modulus ``E`` (Pa) and Poisson's ratio ``nu`` (-).
+
+    ``mu = E / (2 (1 + nu))``, ``lam = E nu / ((1 + nu)(1 - 2 nu))``,
+    ``K = lam + 2 mu / 3`` (MODEL.md section 1). The one home of these formulas.
+    """
+    mu = E / (2.0 * (1.0 + nu))
+    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    return mu, lam, lam + 2.0 * mu / 3.0
 
 
 @dataclass(frozen=True)
@@ -44,17 +55,17 @@ class Elastic:
     @property
     def mu(self) -> float:
         """Shear modulus (Pa)."""
-        return self.E / (2.0 * (1.0 + self.nu))
+        return lame_parameters(self.E, self.nu)[0]
 
     @property
     def lam(self) -> float:
         """First Lame parameter (Pa)."""
-        return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+        return lame_parameters(self.E, self.nu)[1]
 
     @property
     def bulk(self) -> float:
         """Bulk modulus K = lam + 2 mu / 3 (Pa)."""
-        return self.lam + 2.0 * self.mu / 3.0
+        return lame_parameters(self.E, self.nu)[2]
 
     @property
     def p_wave_speed(self) -> float:

@@ -309,7 +309,7 @@ class WeakLayer:
         self.failed = wp.zeros(g.count, dtype=wp.uint8, device=sim.device)
         self.action = wp.launch(
             weak_layer_kernel(T), g.count,
-            inputs=[sim.state.F[g.start:g.end], self.log_jp, self.ref, self.failed, sim.state.clock, float(t_ref),
+            inputs=[sim.state.H[g.start:g.end], self.log_jp, self.ref, self.failed, sim.state.clock, float(t_ref),
                     int(bool(brittle)), T(m.mu), T(m.lam), T(m.M), T(m.beta), T(m.xi), T(m.p0_floor),
                     T(log_jp_failed), T(self.YIELD_TOL)],
             device=sim.device, record_cmd=True)

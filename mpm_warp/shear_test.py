@@ -174,7 +174,7 @@ class ShearMonitor:
         wl = self.wl
         m = wl.material
         p, q = sim.stress_invariants()
-        F = sim.state.F.numpy()[wl.start:wl.end].astype(np.float64)
+        F = sim.state.elastic_deformation_gradient()[wl.start:wl.end]
         c, flag = self.weak.collapse()
         d_wl = float(self.scene["weak_layer_thickness"])
         imp = float(self.impulse.numpy()[0])

@@ -20,8 +20,8 @@ import warp as wp
 from . import io
 from .device import resolve_device
 from .errors import InvalidArgument, SimulationBlowUp
-from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_invariants_kernel
-from .model import SINGULAR_VALUE_FLOOR, Model, State
+from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_kernel
+from .model import Model, State, material_params
 from .scenario import OUTPUT_FIELDS, Scenario
 from .step import Stepper
 
@@ -129,39 +129,53 @@ class Simulation:
         return float(self.state.clock.numpy()[0])
 
     def energies(self) -> dict[str, float]:
-        """Kinetic and elastic energy (J) of the current state."""
+        """Kinetic and elastic energy (J; J/m of depth in 2D) of the current state."""
         self._energy.zero_()
         T = self.model.T
         s = self.state
         for g in self.model.groups:
             sl = slice(g.start, g.end)
-            m = g.material
-            wp.launch(energy_kernel(T), g.count,
-                      inputs=[s.v[sl], s.F[sl], T(g.mass), T(g.vol0), T(m.mu), T(m.lam), T(SINGULAR_VALUE_FLOOR),
+            hz = s.hzz[sl] if s.hzz is not None else None
+            wp.launch(energy_kernel(self.model.dim, T), g.count,
+                      inputs=[s.v[sl], s.H[sl], hz, T(g.mass), T(g.vol0), material_params(g.material, T),
                               self._energy], device=self.device)
         e = self._energy.numpy()
         return {"kinetic_energy": float(e[0]), "elastic_energy": float(e[1])}
 
-    def stress_invariants(self) -> tuple[np.ndarray, np.ndarray]:
-        """Pressure p and Mises stress q (Pa, Kirchhoff) of every particle."""
+    def stresses(self, cauchy: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Pressure p and Mises stress q (Pa, Kirchhoff, compression positive) of every particle and,
+        with ``cauchy``, the Cauchy stress tensor (N, 3, 3) (Pa, tension positive; plane strain: in-plane
+        block and ``sigma_zz``)."""
         T = self.model.T
         n = self.model.n_particles
+        s = self.state
         p = wp.zeros(n, dtype=T, device=self.device)
         q = wp.zeros(n, dtype=T, device=self.device)
+        sig = wp.zeros(n, dtype=wp.types.matrix((3, 3), T), device=self.device) if cauchy else None
         for g in self.model.groups:
             sl = slice(g.start, g.end)
-            m = g.material
-            wp.launch(stress_invariants_kernel(T), g.count,
-                      inputs=[self.state.F[sl], T(m.mu), T(m.lam), T(SINGULAR_VALUE_FLOOR), p[sl], q[sl]],
+            hz = s.hzz[sl] if s.hzz is not None else None
+            wp.launch(stress_kernel(self.model.dim, T), g.count,
+                      inputs=[s.H[sl], hz, material_params(g.material, T), int(cauchy), p[sl], q[sl],
+                              sig[sl] if cauchy else None],
                       device=self.device)
-        return p.numpy(), q.numpy()
+        return p.numpy(), q.numpy(), sig.numpy() if cauchy else None
+
+    def stress_invariants(self) -> tuple[np.ndarray, np.ndarray]:
+        """Pressure p and Mises stress q (Pa, Kirchhoff, compression positive) of every particle."""
+        p, q, _ = self.stresses()
+        return p, q
 
     def particle_field(self, name: str) -> np.ndarray:
         """Host copy of one output field for all particles (see ``OUTPUT_FIELDS``)."""
         s = self.state
         n = self.model.n_particles
-        if name in ("x", "v", "F"):
+        if name in ("x", "v"):
             return getattr(s, name).numpy()
+        if name == "F":
+            return s.elastic_deformation_gradient().astype(self.model.np_dtype)
+        if name == "stress":
+            return self.stresses(cauchy=True)[2]
         if name == "log_jp":
             out = np.zeros(n, dtype=self.model.np_dtype)
             if s.log_jp is not None:
@@ -189,14 +203,13 @@ class Simulation:
         self._bad.fill_(INT_MAX)
         s = self.state
         T = self.model.T
-        wp.launch(health_kernel(T), self.model.n_particles,
-                  inputs=[s.x, s.v, s.F, s.clock, T(self.model.dx), T(MAX_CELLS_PER_STEP), self._bad],
+        wp.launch(health_kernel(self.model.dim, T), self.model.n_particles,
+                  inputs=[s.x, s.v, s.H, s.hzz, s.clock, T(self.model.dx), T(MAX_CELLS_PER_STEP), self._bad],
                   device=self.device)
         bad = self._bad.numpy()
         causes = [("x/v/F", "non-finite value (NaN or Inf)"),
                   ("v", f"moved more than {MAX_CELLS_PER_STEP:g} cell in one step (|v| dt > dx): "
-                        "time step too large for this speed; lower time.cfl or time.dt"),
-                  ("F", "det F_E <= 0 (inverted element)")]
+                        "time step too large for this speed; lower time.cfl or time.dt")]
         for k, (fld, cause) in enumerate(causes):
             if bad[k] != INT_MAX:
                 t, dt, steps = self.stepper.clock()
@@ -324,6 +337,7 @@ class Simulation:
         pf = {}
         for name in self.scenario.output.fields:
             shape, unit, _ = OUTPUT_FIELDS[name]
+            shape = tuple(self.model.dim if c == "dim" else c for c in shape)
             dt = "uint8" if name == "yielded" else self.scenario.precision
             pf[name] = (shape, dt, unit)
         group_id = np.zeros(self.model.n_particles, dtype=np.uint8)
@@ -357,6 +371,8 @@ class Simulation:
         span = t - getattr(self, "_last_frame_time", t)
         self._last_frame_time = t
         forces = (imp / span if span > 0 else np.zeros_like(imp)) if len(imp) else None
+        if forces is not None and forces.shape[1] < 3:  # plane strain: N per metre of depth, z component 0
+            forces = np.pad(forces, ((0, 0), (0, 3 - forces.shape[1])))
         writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
 
     def _frame_diagnostics(self) -> dict:
@@ -371,7 +387,8 @@ class Simulation:
             return
         meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device}
         arrays = self.state.arrays()
-        arrays["vmax"] = self.stepper.vmax.numpy()  # the next step's speed bound, so resume is bit for bit
+        # the next step's speed bound, so resume is bit for bit; one number, so any thread count or device resumes
+        arrays["vmax"] = np.asarray([self.stepper.vmax.numpy().max()])
         io.write_checkpoint(path, arrays, meta)
 
 
@@ -387,7 +404,7 @@ def resume(output: str, device: str | None = None, end_time: float | None = None
     sim = Simulation(sc, device=device)
     sim.state.load_arrays(arrays)
     if "vmax" in arrays:
-        sim.stepper.vmax.assign(arrays["vmax"])
+        sim.stepper.vmax.fill_(float(np.max(arrays["vmax"])))
     else:
         sim.stepper.seed_vmax()
     sim.frame_index = int(meta["frame_index"])

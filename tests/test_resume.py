@@ -44,7 +44,7 @@ def test_checkpoint_holds_the_full_state(tmp_path):
     path = tmp_path / "run.h5"
     _run(path)
     arrays, meta = io.read_checkpoint(io.checkpoint_path_for(str(path)))
-    for k in ("x", "v", "C", "F", "clock", "steps", "vmax"):
+    for k in ("x", "v", "C", "H", "clock", "steps", "vmax"):
         assert k in arrays
     assert meta["frame_index"] == 6
     run = mw.read_run(str(path))
