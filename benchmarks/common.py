@@ -18,21 +18,23 @@ RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 
 def block_scenario(n_grid: int, material=None, boundary: str = "slip", precision: str = "float32",
-                   dt: float = 1e-4) -> mpm_warp.Scenario:
-    """The throughput scene shared with ``taichi_peer.py``.
+                   dt: float = 1e-4, dim: int = 3) -> mpm_warp.Scenario:
+    """The throughput scene shared with ``taichi_mpm.py``.
 
-    Unit box with slip faces three cells in from the grid edge, block
-    ``[0.25, 0.75]^3`` with 8 particles per cell (``n_grid^3`` particles), Hencky
-    elastic E = 1e5 Pa, nu = 0.3, rho = 1000 kg/m^3, gravity, fixed dt = 1e-4 s.
+    Unit box (square in 2D) with slip faces three cells in from the grid edge,
+    block ``[0.25, 0.75]^dim`` with 2 particles per cell and axis
+    (``n_grid^dim`` particles), Hencky elastic E = 1e5 Pa, nu = 0.3,
+    rho = 1000 kg/m^3, gravity along -y, fixed dt = 1e-4 s. ``dim = 2`` is
+    plane strain (per metre of depth).
     """
     dx = 1.0 / n_grid
     mat = material or mpm_warp.Elastic(1e5, 0.3, 1000.0)
     return mpm_warp.Scenario(
-        name=f"block{n_grid}",
-        domain=mpm_warp.Domain((3 * dx,) * 3, (1 - 3 * dx,) * 3, dx, boundary=boundary),
+        name=f"block{n_grid}_{dim}d",
+        domain=mpm_warp.Domain((3 * dx,) * dim, (1 - 3 * dx,) * dim, dx, boundary=boundary, dimension=dim),
         time=mpm_warp.TimeControl(end=1.0, frame_interval=1.0, dt=dt),
         materials={"m": mat},
-        blocks=(mpm_warp.Block("m", (0.25,) * 3, (0.75,) * 3),),
+        blocks=(mpm_warp.Block("m", (0.25,) * dim, (0.75,) * dim),),
         precision=precision,
     )
 

@@ -154,11 +154,11 @@ def part_graph(device: str, quick: bool, deadline: float, out_dir: str, determin
         results[use_graph] = (sim, sec)
     (eager, t_e), (graph, t_g) = results[False], results[True]
     fields = {"x": (eager.state.x, graph.state.x), "v": (eager.state.v, graph.state.v),
-              "F": (eager.state.F, graph.state.F), "log_jp": (eager.state.log_jp, graph.state.log_jp)}
+              "H": (eager.state.H, graph.state.H), "log_jp": (eager.state.log_jp, graph.state.log_jp)}
     diffs = {k: float(np.abs(a.numpy().astype(np.float64) - b.numpy().astype(np.float64)).max())
              for k, (a, b) in fields.items()}
-    obs_e = pb.observables(eager.state.F.numpy(), eager.state.log_jp.numpy())
-    obs_g = pb.observables(graph.state.F.numpy(), graph.state.log_jp.numpy())
+    obs_e = pb.observables(eager.state.elastic_deformation_gradient(), eager.state.log_jp.numpy())
+    obs_g = pb.observables(graph.state.elastic_deformation_gradient(), graph.state.log_jp.numpy())
     out = {"device": device, "n_particles": eager.model.n_particles, "steps": steps + graph.stepper.graph_batch,
            "graph_batch": graph.stepper.graph_batch, "real_cuda_graph": _is_cuda(device),
            "deterministic_atomics": bool(deterministic and _is_cuda(device)),
@@ -225,21 +225,21 @@ class _graph_stand_in:
 
 
 def part_memory(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
-    """Bytes per particle of the particle state and of the grid, elastic and Cam-Clay, 3D."""
+    """Bytes per particle of the particle state and of the grid, elastic and Cam-Clay, 3D and 2D."""
     import warp as wp
     import warp_block
 
-    n_grid = 24 if quick else 128
     rows = []
     wp.init()
     dev = wp.get_device(device)
-    for material in ("elastic", "plastic"):
+    for dim, material in ((3, "elastic"), (3, "plastic"), (2, "elastic"), (2, "plastic")):
+        n_grid = (24 if quick else 128) if dim == 3 else (24 if quick else 1448)
         wp.synchronize_device(dev)
         used0 = wp.get_mempool_used_mem_current(dev) if dev.is_cuda and wp.is_mempool_enabled(dev) else None
-        sim = warp_block.block_simulation(3, material, n_grid, device, n_threads=1)
+        sim = warp_block.block_simulation(dim, material, n_grid, device, n_threads=1)
         N = sim.model.n_particles
         st = sim.stepper
-        row = {"dim": 3, "material": material, "n_grid": n_grid, "n_particles": N,
+        row = {"dim": dim, "material": material, "n_grid": n_grid, "n_particles": N,
                "particle_state_bytes_per_particle": sim.model.bytes_per_particle(sim.state),
                "grid_bytes_per_particle": (st.grid_m_all.capacity + st.grid_p_all.capacity) / N,
                "grid_nodes": int(st.grid_m.size), "grid_copies": st.n_threads}
@@ -248,8 +248,7 @@ def part_memory(device: str, quick: bool, deadline: float, out_dir: str) -> dict
         rows.append(row)
         del sim, st
     return {"device": device, "rows": rows,
-            "note": "2D rows come with the engine's 2D kernels (issue 11 item 1); taichi's counts are in the "
-                    "throughput rows (bytes_per_particle, grid_bytes_per_particle)"}
+            "note": "taichi's counts are in the throughput rows (bytes_per_particle, grid_bytes_per_particle)"}
 
 
 def part_throughput(device: str, quick: bool, deadline: float, out_dir: str) -> dict:

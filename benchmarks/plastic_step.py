@@ -15,8 +15,10 @@ process). Each row records:
   |log_Jp - log_Jp(0)|) and whether they agree within :data:`AGREEMENT`;
 * where the time goes: mpm_warp per stage (one thread), its step with
   plasticity compiled out (an elastic material of the same E, nu, rho on the
-  same state), and the SVD and the return alone on the step's trial states
-  (``return_cost``); Taichi's step with the return compiled out (SVD kept).
+  same state), and its constitutive update and the update's parts alone on
+  the step's trial states (``return_cost``: small-strain check, principal
+  strains, return, and a decomposition-free prototype checked against the
+  engine); Taichi's step with the return compiled out (SVD kept).
 """
 
 from __future__ import annotations
@@ -26,14 +28,12 @@ import os
 import statistics
 import sys
 
-import numpy as np
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import plastic_block as pb  # noqa: E402
 import warp_block  # noqa: E402
 from common import environment, write_json  # noqa: E402
-from return_cost import return_cost  # noqa: E402
+from return_cost import update_cost  # noqa: E402
 from taichi_peer import run_taichi_block_subprocess  # noqa: E402
 
 #: Largest allowed engine difference of each observable, as a fraction of its scale: mean p and mean q
@@ -59,23 +59,15 @@ def compare_size(n_grid: int, steps: int, threads: int, device: str, repeats: in
     sim = warp_block.block_simulation(dim, "plastic", n_grid, device, n_threads=1)
     sim.stepper.set_frame_end(1e9)
     sim.stepper.steps(w["warmup"])
-    cost = return_cost(sim)
-    sim.stepper.steps(1)  # the engine's own update of F_E and log_Jp from the same state
-    w["svd_only_s_per_step"] = cost["trial_svd_s"]
-    w["return_only_s_per_step"] = cost["return_s"]
-    w["series_check_s_per_step"] = cost["series_check_s"]
-    w["return_share"] = cost["return_s"] / w["s_per_step"]
-    w["svd_share"] = cost["trial_svd_s"] / w["s_per_step"]
-    w["series_check_share"] = cost["series_check_s"] / w["s_per_step"]
-    w["svd_free_prototype"] = {
-        "s_per_step": cost["svd_free_update_s"],
-        "max_abs_F_difference_vs_engine": float(np.abs(cost["svd_free_F"] - sim.state.F.numpy()).max()),
-        "max_abs_log_jp_difference_vs_engine": float(np.abs(cost["svd_free_log_jp"] - sim.state.log_jp.numpy()).max()),
-        "replaces_s_per_step": cost["series_check_s"] + cost["trial_svd_s"] + cost["return_s"]}
+    cost = update_cost(sim)
+    w["update_parts_s_per_step"] = cost
+    for part in ("update", "series_check", "principal", "return"):
+        w[f"{part}_share"] = cost[f"{part}_s"] / w["s_per_step"]
     out = {"n_grid": n_grid, "n_particles": w["n_particles"], "threads": threads, "mpm_warp": w}
     print(f"mpm_warp N {w['n_particles']:7d} threads {w['threads']}: {w['particle_steps_per_s'] / 1e6:6.3f} "
-          f"M particle-steps/s; plasticity share {w['plasticity_share']:.2f}, return alone {w['return_share']:.2f}, "
-          f"SVD alone {w['svd_share']:.2f}; min yielded {min(k['yielded'] for k in w['return_kinds']):.3f}",
+          f"M particle-steps/s; plasticity {w['plasticity_share']:.2f} of the step; alone: update "
+          f"{w['update_share']:.2f}, series check {w['series_check_share']:.2f}, eigen {w['principal_share']:.2f}, "
+          f"return {w['return_share']:.2f}; min yielded {min(k['yielded'] for k in w['return_kinds']):.3f}",
           flush=True)
     if not taichi:
         return out

@@ -11,9 +11,8 @@ The elastic block is ``common.block_scenario`` (E = 1e5 Pa, rho = 1000, dt =
 1e-4 s, free fall); the plastic block is the struck Cam-Clay snow of
 ``plastic_block.py``. Both engines follow the protocol of ``warp_block`` /
 ``taichi_peer`` (compiled, warmed up, median of three repeats from one
-snapshot; Taichi in its own process per configuration). 2D is plane strain;
-mpm_warp rows for 2D carry the reason they are missing until the engine has 2D
-kernels. Writes ``benchmarks/results/<name>.json`` (default
+snapshot; Taichi in its own process per configuration). 2D is plane strain
+(``[domain] dimension = 2`` in mpm_warp). Writes ``benchmarks/results/<name>.json`` (default
 ``throughput_<device>``) after every configuration, so a run stopped early
 keeps what it measured.
 """
@@ -47,19 +46,13 @@ def n_grid_for(particles: float, dim: int, material: str = "elastic") -> int:
 
 def measure(dim: int, material: str, n_grid: int, steps: int, device: str, threads: int | None,
             taichi: bool, repeats: int = 3, taichi_timeout_s: float = 600.0) -> list[dict]:
-    """Rows of one configuration: mpm_warp (or the reason it is missing), Taichi, and the ratio."""
-    rows = []
+    """Rows of one configuration: mpm_warp, Taichi (or why it is missing), and the ratio."""
     cuda = device.startswith("cuda")
-    try:
-        w = warp_block.run_block(dim, material, n_grid, steps, device=device, n_threads=threads, repeats=repeats,
-                                 stages=(threads == 1 and not cuda), diagnostics=(material == "plastic"))
-        print(f"mpm_warp {dim}D {material:7s} N {w['n_particles']:9d} threads {w['threads']}: "
-              f"{w['particle_steps_per_s'] / 1e6:8.2f} M particle-steps/s", flush=True)
-    except warp_block.EngineGap as gap:
-        w = {"engine": "mpm_warp", "dim": dim, "material": material, "n_grid": n_grid, "n_particles": n_grid**dim,
-             "threads": threads, "device": device, "error": str(gap)}
-        print(f"mpm_warp {dim}D {material:7s} N {n_grid**dim:9d}: missing ({gap})", flush=True)
-    rows.append(w)
+    w = warp_block.run_block(dim, material, n_grid, steps, device=device, n_threads=threads, repeats=repeats,
+                             stages=(threads == 1 and not cuda), diagnostics=(material == "plastic"))
+    print(f"mpm_warp {dim}D {material:7s} N {w['n_particles']:9d} threads {w['threads']}: "
+          f"{w['particle_steps_per_s'] / 1e6:8.2f} M particle-steps/s", flush=True)
+    rows = [w]
     if not taichi:
         return rows
     arch = "cuda" if cuda else "cpu"
@@ -72,11 +65,9 @@ def measure(dim: int, material: str, n_grid: int, steps: int, device: str, threa
         print(f"taichi   {dim}D {material:7s} N {n_grid**dim:9d}: unavailable ({err})", flush=True)
         return rows
     rows.append(res)
-    msg = ""
-    if "particle_steps_per_s" in w:
-        w["taichi_particle_steps_per_s"] = res["particle_steps_per_s"]
-        w["ratio_vs_taichi"] = w["particle_steps_per_s"] / res["particle_steps_per_s"]
-        msg = f"  -> mpm_warp/taichi {w['ratio_vs_taichi']:.2f}"
+    w["taichi_particle_steps_per_s"] = res["particle_steps_per_s"]
+    w["ratio_vs_taichi"] = w["particle_steps_per_s"] / res["particle_steps_per_s"]
+    msg = f"  -> mpm_warp/taichi {w['ratio_vs_taichi']:.2f}"
     print(f"taichi   {dim}D {material:7s} N {res['n_particles']:9d} threads {res['threads']}: "
           f"{res['particle_steps_per_s'] / 1e6:8.2f} M particle-steps/s{msg}", flush=True)
     return rows

@@ -29,14 +29,6 @@ from common import block_scenario, stage_times  # noqa: E402
 
 import mpm_warp  # noqa: E402
 
-#: Why 2D mpm_warp rows are missing until the engine has 2D kernels (issue 11, item 1).
-NO_2D = ("mpm_warp has no 2D (plane-strain) kernels on this branch yet (issue 11 item 1); "
-         "wire warp_block.block_simulation for dim = 2 once they land")
-
-
-class EngineGap(RuntimeError):
-    """The engine cannot run this configuration yet (the message says why)."""
-
 
 def plastic_material() -> mpm_warp.CamClaySnow:
     """The Cam-Clay snow of ``plastic_block``."""
@@ -51,7 +43,7 @@ def block_simulation(dim: int, material: str, n_grid: int, device: str = "cpu", 
     Parameters
     ----------
     dim : {2, 3}
-        2D runs raise :class:`EngineGap` until the engine has 2D kernels.
+        2 is plane strain (``[domain] dimension = 2``).
     material : {"elastic", "plastic"}
         The elastic block (``common.block_scenario``) or the struck Cam-Clay
         block of ``plastic_block`` (its ``v`` and exact ``C`` assigned).
@@ -63,15 +55,15 @@ def block_simulation(dim: int, material: str, n_grid: int, device: str = "cpu", 
         Cam-Clay scene with an elastic material of the same E, nu, rho: the
         same step with plasticity compiled out (no yield check, no return).
     """
-    if dim != 3:
-        raise EngineGap(NO_2D)
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim}")
     if material == "elastic":
-        return mpm_warp.Simulation(block_scenario(n_grid), device=device, n_threads=n_threads)
+        return mpm_warp.Simulation(block_scenario(n_grid, dim=dim), device=device, n_threads=n_threads)
     if material != "plastic":
         raise ValueError(f"material must be 'elastic' or 'plastic', got {material!r}")
     pb.check_n_grid(n_grid)
     mat = mpm_warp.Elastic(pb.YOUNG_E, pb.POISSON_NU, pb.DENSITY) if elastic_twin else plastic_material()
-    sc = block_scenario(n_grid, material=mat, dt=pb.time_step(n_grid))
+    sc = block_scenario(n_grid, material=mat, dt=pb.time_step(n_grid), dim=dim)
     if track_yield:
         sc = dataclasses.replace(sc, output=mpm_warp.Output(fields=("x", "yielded")))
     sim = mpm_warp.Simulation(sc, device=device, n_threads=n_threads)
@@ -154,7 +146,7 @@ def run_block(dim: int, material: str, n_grid: int, steps: int, device: str = "c
            "particle_steps_per_s": N / med, "bytes_per_particle": sim.model.bytes_per_particle(sim.state),
            "grid_bytes_per_particle": (st.grid_m_all.capacity + st.grid_p_all.capacity) / N}
     if material == "plastic":
-        row["observables"] = pb.observables(sim.state.F.numpy(), sim.state.log_jp.numpy())
+        row["observables"] = pb.observables(sim.state.elastic_deformation_gradient(), sim.state.log_jp.numpy())
     else:
         row["com_y"] = float(sim.state.x.numpy()[:, 1].astype(np.float64).mean())
     if stages and st.n_threads == 1:
