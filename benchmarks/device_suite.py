@@ -26,7 +26,7 @@ the CPU in seconds, as ``tests/test_device_suite.py`` does in CI):
     from the same state: bit-for-bit equality (``graph_deterministic``, Warp's
     run-to-run deterministic atomics; on the CPU every run is deterministic and
     a stand-in replays the captured step batches) or the observables within
-    ``plastic_step.AGREEMENT`` (production atomics), and the seconds per step
+    ``plastic_block.AGREEMENT`` (production atomics), and the seconds per step
     of both.
 ``memory``
     Device bytes per particle of the particle state and of the grid, elastic
@@ -133,7 +133,6 @@ def part_graph(device: str, quick: bool, deadline: float, out_dir: str, determin
         wp.config.deterministic = wp.DeterministicMode.RUN_TO_RUN  # before any kernel module exists
     import plastic_block as pb
     import warp_block
-    from plastic_step import AGREEMENT, agreement
 
     n_grid = 24 if quick else 64
     steps = 6 if quick else 200
@@ -164,9 +163,9 @@ def part_graph(device: str, quick: bool, deadline: float, out_dir: str, determin
            "deterministic_atomics": bool(deterministic and _is_cuda(device)),
            "eager_s_per_step": t_e, "graph_s_per_step": t_g, "graph_speedup": t_e / t_g if t_g > 0 else None,
            "max_abs_difference": diffs, "bit_for_bit": all(d == 0.0 for d in diffs.values()),
-           "observables_eager": obs_e, "observables_graph": obs_g, "agreement": agreement(obs_e, obs_g)}
+           "observables_eager": obs_e, "observables_graph": obs_g, "agreement": pb.agreement(obs_e, obs_g)}
     bitwise_expected = deterministic or not _is_cuda(device)
-    out["expectation"] = "bit for bit" if bitwise_expected else f"observables within {AGREEMENT:g}"
+    out["expectation"] = "bit for bit" if bitwise_expected else f"observables within {pb.AGREEMENT:g}"
     out["ok"] = out["bit_for_bit"] if bitwise_expected else out["agreement"]["agree"]
     return out
 

@@ -203,3 +203,18 @@ def observables(F, log_jp, F_zz=None) -> dict:
     lj = np.asarray(log_jp, dtype=np.float64)
     return {"mean_p": float(p.mean()), "mean_q": float(q.mean()), "mean_log_jp": float(lj.mean()),
             "mean_abs_dlog_jp": float(np.abs(lj - initial_log_jp()).mean())}
+
+
+#: Largest allowed engine difference of each observable, as a fraction of its scale: mean p and mean q
+#: against p0_ini (3.7 Pa: the two engines take different float32 paths, series or SVD strain and a
+#: corrected or rebuilt F_E, and one float32 unit of strain is 0.05 Pa of pressure, summed over ~100
+#: steps of returns), log_Jp against the mean plastic volume change.
+AGREEMENT = 1.0e-3
+
+
+def agreement(a: dict, b: dict) -> dict:
+    """Scaled differences of the observables of two engines and whether all are within :data:`AGREEMENT`."""
+    scale = {"mean_p": P0_INI, "mean_q": P0_INI,
+             "mean_log_jp": max(a["mean_abs_dlog_jp"], 1e-12), "mean_abs_dlog_jp": max(a["mean_abs_dlog_jp"], 1e-12)}
+    diff = {k: abs(a[k] - b[k]) / scale[k] for k in scale}
+    return {"scaled_differences": diff, "tolerance": AGREEMENT, "agree": all(d <= AGREEMENT for d in diff.values())}

@@ -12,7 +12,7 @@ process). Each row records:
 * the return kinds of every timed step in both engines (fraction yielding, cap
   and dry-side returns), checked against ``plastic_block.check_return_kinds``;
 * the observables after the same steps (mean p, mean q, mean log_Jp, mean
-  |log_Jp - log_Jp(0)|) and whether they agree within :data:`AGREEMENT`;
+  |log_Jp - log_Jp(0)|) and whether they agree within ``plastic_block.AGREEMENT``;
 * where the time goes: mpm_warp per stage (one thread), its step with
   plasticity compiled out (an elastic material of the same E, nu, rho on the
   same state), and its constitutive update and the update's parts alone on
@@ -35,20 +35,6 @@ import warp_block  # noqa: E402
 from common import environment, write_json  # noqa: E402
 from return_cost import update_cost  # noqa: E402
 from taichi_peer import run_taichi_block_subprocess  # noqa: E402
-
-#: Largest allowed engine difference of each observable, as a fraction of its scale: mean p and mean q
-#: against p0_ini (3.7 Pa: the two engines take different float32 paths, series or SVD strain and a
-#: corrected or rebuilt F_E, and one float32 unit of strain is 0.05 Pa of pressure, summed over ~100
-#: steps of returns), log_Jp against the mean plastic volume change.
-AGREEMENT = 1.0e-3
-
-
-def agreement(a: dict, b: dict) -> dict:
-    """Scaled differences of the observables of two engines and whether all are within :data:`AGREEMENT`."""
-    scale = {"mean_p": pb.P0_INI, "mean_q": pb.P0_INI,
-             "mean_log_jp": max(a["mean_abs_dlog_jp"], 1e-12), "mean_abs_dlog_jp": max(a["mean_abs_dlog_jp"], 1e-12)}
-    diff = {k: abs(a[k] - b[k]) / scale[k] for k in scale}
-    return {"scaled_differences": diff, "tolerance": AGREEMENT, "agree": all(d <= AGREEMENT for d in diff.values())}
 
 
 def compare_size(n_grid: int, steps: int, threads: int, device: str, repeats: int, taichi: bool) -> dict:
@@ -81,7 +67,7 @@ def compare_size(n_grid: int, steps: int, threads: int, device: str, repeats: in
         return out
     out["taichi"] = t
     out["ratio_vs_taichi"] = w["particle_steps_per_s"] / t["particle_steps_per_s"]
-    out["agreement"] = agreement(w["observables"], t["observables"])
+    out["agreement"] = pb.agreement(w["observables"], t["observables"])
     print(f"taichi   N {t['n_particles']:7d} threads {t['threads']}: {t['particle_steps_per_s'] / 1e6:6.3f} "
           f"M particle-steps/s ({t['p2g_scatter']}); return share {t['return_share']:.2f} -> warp/taichi "
           f"{out['ratio_vs_taichi']:.2f}; observables agree: {out['agreement']['agree']}", flush=True)

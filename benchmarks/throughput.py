@@ -68,6 +68,9 @@ def measure(dim: int, material: str, n_grid: int, steps: int, device: str, threa
     w["taichi_particle_steps_per_s"] = res["particle_steps_per_s"]
     w["ratio_vs_taichi"] = w["particle_steps_per_s"] / res["particle_steps_per_s"]
     msg = f"  -> mpm_warp/taichi {w['ratio_vs_taichi']:.2f}"
+    if material == "plastic" and "observables" in res:
+        w["agreement_with_taichi"] = pb.agreement(w["observables"], res["observables"])
+        msg += f"; observables agree: {w['agreement_with_taichi']['agree']}"
     print(f"taichi   {dim}D {material:7s} N {res['n_particles']:9d} threads {res['threads']}: "
           f"{res['particle_steps_per_s'] / 1e6:8.2f} M particle-steps/s{msg}", flush=True)
     return rows

@@ -78,19 +78,23 @@ def default_warmup(material: str, n_grid: int) -> int:
     return pb.warmup_steps(n_grid) if material == "plastic" else 3
 
 
-def _timed(sim: mpm_warp.Simulation, snap: dict, steps: int, repeats: int) -> list[float]:
-    """Seconds per step of ``repeats`` batches of ``steps`` steps, each from the snapshot."""
+def _timed(sim: mpm_warp.Simulation, snap: dict, steps: int, repeats: int) -> tuple[list[float], list[float]]:
+    """Seconds per step of ``repeats`` batches of ``steps`` steps, each from the snapshot, and the process
+    CPU time over the wall time of each (well below the thread count: the cores were shared)."""
     st = sim.stepper
-    out = []
+    out, util = [], []
     for _ in range(repeats):
         sim.state.load_arrays(snap)
         st.set_frame_end(1e9)
         wp.synchronize_device(sim.device)
+        c0 = time.process_time()
         t0 = time.perf_counter()
         st.steps(steps)
         wp.synchronize_device(sim.device)
-        out.append((time.perf_counter() - t0) / steps)
-    return out
+        wall = time.perf_counter() - t0
+        out.append(wall / steps)
+        util.append((time.process_time() - c0) / wall)
+    return out, util
 
 
 def return_kinds_per_step(dim: int, n_grid: int, snap: dict, steps: int, device: str, n_threads: int | None):
@@ -121,7 +125,9 @@ def run_block(dim: int, material: str, n_grid: int, steps: int, device: str = "c
     dict
         ``engine``, ``dim``, ``material``, ``n_grid``, ``n_particles``,
         ``threads``, ``warmup``, ``steps``, ``dt``, ``s_per_step`` (median),
-        ``times_s_per_step``, ``particle_steps_per_s``, ``bytes_per_particle``
+        ``times_s_per_step``, ``cpu_utilisation`` (median process CPU time over
+        wall time; on the CPU well below ``threads`` means the cores were
+        shared), ``particle_steps_per_s``, ``bytes_per_particle``
         (particle state), ``grid_bytes_per_particle`` (all grid copies), and
         ``com_y`` (elastic) or ``observables`` (Cam-Clay, see
         ``plastic_block.observables``); with ``stages`` the per-stage seconds
@@ -137,12 +143,13 @@ def run_block(dim: int, material: str, n_grid: int, steps: int, device: str = "c
     st.steps(W)  # compiles every kernel of the plan
     wp.synchronize_device(sim.device)
     snap = {k: np.array(a, copy=True) for k, a in sim.state.arrays().items()}  # on the CPU .numpy() is a view
-    ts = _timed(sim, snap, steps, repeats)
+    ts, util = _timed(sim, snap, steps, repeats)
     med = statistics.median(ts)
     N = sim.model.n_particles
     row = {"engine": "mpm_warp", "dim": dim, "material": material, "n_grid": n_grid, "n_particles": N,
            "threads": st.n_threads, "device": sim.device, "warmup": W, "steps": steps,
            "dt": float(sim.scenario.time.dt), "s_per_step": med, "times_s_per_step": ts,
+           "cpu_utilisation": statistics.median(util),
            "particle_steps_per_s": N / med, "bytes_per_particle": sim.model.bytes_per_particle(sim.state),
            "grid_bytes_per_particle": (st.grid_m_all.capacity + st.grid_p_all.capacity) / N}
     if material == "plastic":
@@ -161,7 +168,7 @@ def run_block(dim: int, material: str, n_grid: int, steps: int, device: str = "c
         twin_snap = {k: v for k, v in snap.items() if k != "log_jp"}
         twin.stepper.set_frame_end(1e9)
         twin.stepper.steps(1)  # compile
-        t_el = statistics.median(_timed(twin, twin_snap, steps, repeats))
+        t_el = statistics.median(_timed(twin, twin_snap, steps, repeats)[0])
         row["no_plasticity_s_per_step"] = t_el
         row["plasticity_share"] = 1.0 - t_el / med
     return row

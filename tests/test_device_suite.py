@@ -86,11 +86,9 @@ def test_throughput_rows(quick):
     if importlib.util.find_spec("taichi") is None:
         assert all("not installed" in r["error"] for r in taichi.values())
         return
-    from plastic_step import agreement
-
     tp = taichi[(3, "plastic")]
     assert tp["warmup"] == pl["warmup"] and tp["return_kind_problems"] == []
-    assert agreement(pl["observables"], tp["observables"])["agree"]
+    assert pb.agreement(pl["observables"], tp["observables"])["agree"]
     assert taichi[(3, "elastic")]["com_y_after"] == pytest.approx(el["com_y"], abs=1e-6)
 
 
