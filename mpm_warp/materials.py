@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 
-from .validate import finite_number
+from .checks import finite_number
 
 __all__ = ["Elastic", "CamClaySnow", "Material", "material_from_dict", "MATERIAL_MODELS"]
 

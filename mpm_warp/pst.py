@@ -60,9 +60,9 @@ import numpy as np
 import warp as wp
 
 from . import fronts
+from .checks import finite_number
 from .errors import ScenarioError
 from .kernels.snow import pst_action_kernel, weak_layer_kernel
-from .validate import finite_number
 
 __all__ = ["build_pst", "attach", "run_pst", "PSTMonitor", "slab_normal_stress",
            "weak_layer_material", "GRAVITY"]

@@ -18,9 +18,9 @@ import math
 import os
 from dataclasses import MISSING, asdict, dataclass, field, fields, replace
 
+from .checks import choice, finite_number, positive_int, vector3
 from .errors import InvalidArgument, ScenarioError
 from .materials import Elastic, material_from_dict
-from .validate import choice, finite_number, positive_int, vector3
 from .walls import WALL_KINDS, Wall
 
 try:  # Python >= 3.11

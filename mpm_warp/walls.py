@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from .validate import choice, finite_number, vector3
+from .checks import choice, finite_number, vector3
 
 __all__ = ["Wall", "WALL_KINDS", "box_walls"]
 

@@ -1,4 +1,4 @@
-"""Small checks that turn bad input into :class:`InvalidArgument` naming the field."""
+"""Argument checks that turn bad input into :class:`InvalidArgument` naming the field, the value and the range."""
 
 from __future__ import annotations
 
