@@ -28,8 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = [
-    "GRAVITY", "heierli_speed", "heierli_touchdown", "rayleigh_speed", "critical_cut_length_formula",
-    "hardening_collapse", "collapse_fraction", "front_position", "front_from_arrival", "LineFit",
+    "GRAVITY", "heierli_speed", "heierli_touchdown", "critical_cut_length_formula",
+    "collapse_fraction", "front_position", "front_from_arrival", "LineFit",
     "steady_speed", "arrival_speed", "touchdown_distance", "marker_displacements", "pst_summary", "Bisection",
     "bisect_threshold", "critical_cut_length", "ShearSummary", "shear_summary",
 ]
@@ -53,25 +53,10 @@ def heierli_touchdown(E: float, h: float, rho: float, h_f: float, g: float = GRA
     return 2.331 * (2.0 * max(h_f, 0.0) * D_f / (g * rho * h)) ** 0.25
 
 
-def rayleigh_speed(E: float, nu: float, rho: float) -> float:
-    """Rayleigh wave speed ``c_s (0.862 + 1.14 nu) / (1 + nu)`` (m/s)."""
-    c_s = math.sqrt(E / (2.0 * (1.0 + nu)) / rho)
-    return c_s * (0.862 + 1.14 * nu) / (1.0 + nu)
-
-
 def critical_cut_length_formula(tau_p: float, E: float, nu: float, D_wl: float, G_wl: float, rho: float,
                                 g: float = GRAVITY) -> float:
     """Flat-ground critical cut length ``sqrt(2 tau_p E' D_wl / (G_wl rho g))`` (m), ``E' = E/(1-nu^2)``."""
     return math.sqrt(2.0 * tau_p * E / (1.0 - nu**2) * D_wl / (G_wl * rho * g))
-
-
-def hardening_collapse(p: float, K: float, xi: float, p0_ini: float = 0.0) -> float:
-    """Collapse ``1 - J_P`` on the cap from ``p0_ini`` to ``p`` (Pa): ``1 - exp(-(asinh(p/K) - asinh(p0_ini/K))/xi)``.
-
-    Zero when ``p <= p0_ini`` (no compaction on the cap below the consolidation pressure).
-    """
-    d = math.asinh(p / K) - math.asinh(p0_ini / K)
-    return 1.0 - math.exp(-d / xi) if d > 0 else 0.0
 
 
 # ----------------------------------------------------------------------------- collapse and front

@@ -9,9 +9,40 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 
-from .checks import finite_number
+import numpy as np
 
-__all__ = ["Elastic", "CamClaySnow", "Material", "material_from_dict", "MATERIAL_MODELS"]
+from .checks import finite_number
+from .kernels.camclay import initial_log_jp
+
+__all__ = ["Elastic", "CamClaySnow", "Material", "material_from_dict", "MATERIAL_MODELS", "lame_parameters",
+           "hardening_collapse"]
+
+
+def lame_parameters(E, nu):
+    """Shear modulus, first Lame parameter and bulk modulus ``(mu, lam, K)`` (Pa) of ``E`` (Pa) and ``nu`` (-).
+
+    ``mu = E / (2 (1 + nu))``, ``lam = E nu / ((1 + nu)(1 - 2 nu))``, ``K = lam + 2 mu / 3``
+    (MODEL.md 1). Floats or NumPy arrays; the one home of these formulas (a material's
+    :attr:`Elastic.mu`, :attr:`Elastic.lam` and :attr:`Elastic.bulk` call it).
+    """
+    mu = E / (2.0 * (1.0 + nu))
+    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    return mu, lam, lam + 2.0 * mu / 3.0
+
+
+def hardening_collapse(p, K: float, xi: float, p0_ini: float = 0.0):
+    """Plastic collapse ``1 - J_P / J_P,ini`` of Cam-Clay snow consolidated on the cap from ``p0_ini`` to ``p`` (-).
+
+    ``1 - exp(log_Jp(p) - log_Jp(p0_ini))`` with the hardening state of a consolidation
+    pressure, ``log_Jp(p0) = -asinh(p0 / K) / xi`` (:func:`mpm_warp.kernels.camclay.initial_log_jp`,
+    MODEL.md 3 and 6), i.e. ``1 - exp(-(asinh(p/K) - asinh(p0_ini/K)) / xi)``; zero where
+    ``p <= p0_ini`` (the cap does not move below its consolidation pressure). ``p``, ``p0_ini``
+    and ``K`` in Pa; ``p`` a float or an array.
+    """
+    log_jp = np.vectorize(initial_log_jp, otypes=[float])
+    c = 1.0 - np.exp(log_jp(p, K, xi) - initial_log_jp(p0_ini, K, xi))
+    c = np.where(np.asarray(p, dtype=float) > p0_ini, c, 0.0)
+    return float(c) if c.ndim == 0 else c
 
 
 @dataclass(frozen=True)
@@ -43,18 +74,18 @@ class Elastic:
 
     @property
     def mu(self) -> float:
-        """Shear modulus (Pa)."""
-        return self.E / (2.0 * (1.0 + self.nu))
+        """Shear modulus (Pa), :func:`lame_parameters`."""
+        return lame_parameters(self.E, self.nu)[0]
 
     @property
     def lam(self) -> float:
-        """First Lame parameter (Pa)."""
-        return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+        """First Lame parameter (Pa), :func:`lame_parameters`."""
+        return lame_parameters(self.E, self.nu)[1]
 
     @property
     def bulk(self) -> float:
-        """Bulk modulus K = lam + 2 mu / 3 (Pa)."""
-        return self.lam + 2.0 * self.mu / 3.0
+        """Bulk modulus K = lam + 2 mu / 3 (Pa), :func:`lame_parameters`."""
+        return lame_parameters(self.E, self.nu)[2]
 
     @property
     def p_wave_speed(self) -> float:
@@ -122,8 +153,13 @@ class CamClaySnow(Elastic):
 
     @property
     def initial_log_jp(self) -> float:
-        """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (MODEL.md 3)."""
-        return -math.asinh(self.p0_ini / self.bulk) / self.xi
+        """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (MODEL.md 3; :func:`mpm_warp.kernels.camclay.initial_log_jp`)."""
+        return initial_log_jp(self.p0_ini, self.bulk, self.xi)
+
+    def collapse_at(self, p) -> float:
+        """Collapse ``1 - J_P / J_P,ini`` (-) consolidating from ``p0_ini`` to the pressure ``p`` (Pa),
+        :func:`hardening_collapse`."""
+        return hardening_collapse(p, self.bulk, self.xi, self.p0_ini)
 
 
 Material = Elastic | CamClaySnow

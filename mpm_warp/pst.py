@@ -63,6 +63,7 @@ from . import fronts
 from .checks import finite_number
 from .errors import ScenarioError
 from .kernels.snow import pst_action_kernel, weak_layer_kernel
+from .materials import CamClaySnow, Elastic
 
 __all__ = ["build_pst", "attach", "run_pst", "PSTMonitor", "slab_normal_stress",
            "weak_layer_material", "GRAVITY"]
@@ -247,9 +248,10 @@ def build_pst(raw: dict) -> dict:
     markers = [float(m) for m in np.arange(0.5 * spacing, L, spacing)]
 
     E, nu, rho = float(slab["E"]), float(slab["nu"]), float(slab["density"])
+    slab_mat = Elastic(E, nu, rho)
     wl_mat = mats["weak_layer"]
-    K_wl = float(wl["E"]) / (3.0 * (1.0 - 2.0 * float(wl["nu"])))
-    collapse_law = fronts.hardening_collapse(sigma_n, K_wl, float(wl["xi"]))
+    wl_cc = CamClaySnow(float(wl["E"]), float(wl["nu"]), float(wl["density"]), xi=float(wl["xi"]))
+    collapse_law = wl_cc.collapse_at(sigma_n)
     s["derived"] = {
         "sigma_n": sigma_n, "p0_ini": wl_mat["p0_ini"], "p_oedometric": oedometric_pressure(sigma_n, float(wl["nu"])),
         "collapse_fraction_law": collapse_law, "collapse_height_law": collapse_law * Dwl,
@@ -257,8 +259,8 @@ def build_pst(raw: dict) -> dict:
         "bin": bin_w, "threshold": thr, "markers": markers, "slab_base_y": Dwl, "width_z": wz,
         "heierli_speed": fronts.heierli_speed(E, D, rho, collapse_law * Dwl),
         "heierli_touchdown": fronts.heierli_touchdown(E, D, rho, collapse_law * Dwl),
-        "rayleigh_speed": fronts.rayleigh_speed(E, nu, rho),
-        "shear_wave_speed": math.sqrt(E / (2.0 * (1.0 + nu)) / rho),
+        "rayleigh_speed": slab_mat.rayleigh_speed,
+        "shear_wave_speed": slab_mat.s_wave_speed,
     }
     raw["scene"] = s
     raw["domain"] = domain

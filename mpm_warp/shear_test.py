@@ -37,6 +37,7 @@ import warp as wp
 from . import fronts
 from .errors import ScenarioError
 from .kernels.snow import push_kernel
+from .materials import CamClaySnow
 from .pst import (
     GRAVITY,
     SETTLE_DEFAULTS,
@@ -104,10 +105,11 @@ def build_shear_test(raw: dict) -> dict:
          "particles_per_cell": ppc},
     ]
     walls = [{"name": "substratum", "point": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0], "kind": "sticky"}]
-    K = float(s["weak_layer"]["E"]) / (3.0 * (1.0 - 2.0 * float(s["weak_layer"]["nu"])))
+    wlp = s["weak_layer"]
+    wl_cc = CamClaySnow(float(wlp["E"]), float(wlp["nu"]), float(wlp["density"]), xi=float(wlp["xi"]))
     s["derived"] = {"sigma_n": sigma_n, "load_density": load_density, "push_start": t_settle,
                     "sample_area": Ls * wz, "width_z": wz, "p0_ini": mats["weak_layer"]["p0_ini"],
-                    "collapse_fraction_law": fronts.hardening_collapse(sigma_n, K, float(s["weak_layer"]["xi"]))}
+                    "collapse_fraction_law": wl_cc.collapse_at(sigma_n)}
     raw["scene"] = s
     raw["domain"] = wz_domain
     raw["materials"] = mats

@@ -56,24 +56,6 @@ def observed_order(h, err) -> float:
     return float(np.polyfit(np.log(np.asarray(h, float)), np.log(np.asarray(err, float)), 1)[0])
 
 
-def kirchhoff_stress(F, mu: float, lam: float) -> np.ndarray:
-    """Hencky Kirchhoff stress ``U diag(2 mu ln s + lam tr ln s) U^T`` (Pa, tension positive).
-
-    ``F = U diag(s) V^T`` of shape (n, 3, 3); computed in float64 with numpy,
-    independently of the kernels (MODEL.md 1).
-    """
-    U, s, _ = np.linalg.svd(np.asarray(F, dtype=np.float64))
-    eps = np.log(s)
-    t = 2.0 * mu * eps + lam * eps.sum(axis=-1, keepdims=True)
-    return np.einsum("nij,nj,nkj->nik", U, t, U)
-
-
-def hencky_cauchy_stress(F, mu: float, lam: float) -> np.ndarray:
-    """Hencky Cauchy stress ``tau / det F`` (Pa, tension positive), shape (n, 3, 3), float64."""
-    F = np.asarray(F, dtype=np.float64)
-    return kirchhoff_stress(F, mu, lam) / np.linalg.det(F)[:, None, None]
-
-
 def _cells(name: str, length: float, dx: float) -> int:
     """``length / dx`` as an integer, or InvalidArgument (blocks must fill whole cells)."""
     if not (isinstance(dx, (int, float)) and math.isfinite(dx) and dx > 0):

@@ -10,8 +10,9 @@ from ..errors import MPMError
 from ..materials import Elastic
 from ..scenario import Block, Domain, Scenario, TimeControl
 from ..simulation import Simulation
+from ..stress import cauchy_stress
 from ..walls import Wall
-from .common import G, _cells, _record, com_velocity, hencky_cauchy_stress, zero_crossings
+from .common import G, _cells, _record, com_velocity, zero_crossings
 
 
 # ------------------------------------------------------------------ axial bar
@@ -193,7 +194,7 @@ def self_weight_column(dx: float = 1.0 / 16.0, *, cfl: float = 0.4, dt: float | 
 
     def sample(s, frame):
         if s.time > t_avg:
-            samples.append(hencky_cauchy_stress(s.state.F.numpy(), mat.mu, mat.lam)[:, 1, 1])
+            samples.append(cauchy_stress(s.state.F.numpy(), mat.mu, mat.lam)[:, 1, 1])
 
     res = sim.run(None, callback=sample)
     syy = np.mean(samples, axis=0)
