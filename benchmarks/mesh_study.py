@@ -64,7 +64,7 @@ from test_weak_layer import (  # noqa: E402
 )
 
 import mpm_warp as mw  # noqa: E402
-from mpm_warp.simulation import versions  # noqa: E402
+from mpm_warp.result import versions  # noqa: E402
 
 RESULTS = os.path.join(HERE, "results")
 DEFAULT_CELLS = (2, 4, 8, 16, 32)  # cells across the weak layer: dx = D_wl / cells

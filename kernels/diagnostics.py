@@ -82,6 +82,40 @@ def stress_invariants_kernel(T):
 
 
 @functools.cache
+def stress_kernel(T):
+    """Cauchy stress tensor ``sigma = tau / J_E`` (Pa, tension positive) of one group, per particle.
+
+    ``F_E = U diag(s) V^T`` (``wp.svd3``), ``tau = U diag(tau_i) U^T`` with the principal Hencky
+    stresses of :func:`mpm_warp.kernels.elasticity.hencky_func` (singular values floored at
+    ``s_floor``) and ``J_E = prod_i max(s_i, s_floor)`` (MODEL.md 1). The host mirror is
+    :func:`mpm_warp.stress.cauchy_stress`; normal and shear stresses on any plane follow from
+    ``sigma`` without recomputing it from ``F_E``.
+    """
+    V = vec3(T)
+    M = mat33(T)
+    hencky = hencky_func(T)
+
+    @wp.kernel(enable_backward=False)
+    def stress(
+        F: wp.array(dtype=M),
+        mu: T,
+        lam: T,
+        s_floor: T,
+        sigma_out: wp.array(dtype=M),
+    ):
+        i = wp.tid()
+        U = M()
+        s = V()
+        Vt = M()
+        wp.svd3(F[i], U, s, Vt)
+        tau = hencky(s, mu, lam, s_floor)
+        J = wp.max(s[0], s_floor) * wp.max(s[1], s_floor) * wp.max(s[2], s_floor)
+        sigma_out[i] = U * wp.diag(tau / J) * wp.transpose(U)
+
+    return stress
+
+
+@functools.cache
 def health_kernel(T):
     """Health check over all particles.
 

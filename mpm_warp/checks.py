@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import typing
 from collections.abc import Sequence
 
 import numpy as np
@@ -55,3 +57,14 @@ def positive_int(field: str, value, *, lo: int = 1, hi: int | None = None) -> in
     if value < lo or (hi is not None and value > hi):
         raise InvalidArgument(field, value, f"an integer in [{lo}, {hi if hi is not None else 'inf'}]")
     return int(value)
+
+
+def check_choices(obj, where: str) -> None:
+    """Check every ``Literal``-typed field of the dataclass ``obj`` and of its nested dataclasses (:func:`choice`)."""
+    hints = typing.get_type_hints(type(obj))
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if typing.get_origin(hints[f.name]) is typing.Literal:
+            choice(f"{where}.{f.name}", value, typing.get_args(hints[f.name]))
+        elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+            check_choices(value, f"{where}.{f.name}")

@@ -89,16 +89,16 @@ def _summary(res, out=sys.stdout):
         f"{res.device}; stepping {res.wall_time:.2f} s ({res.particle_steps_per_s / 1e6:.2f} M particle-steps/s)"
         + (f"; {res.edge_hits} particle clamps at the grid edge" if res.edge_hits else "")
         + (f"\noutput: {res.output}" if res.output else "") + "\n")
-    for k, v in res.extra.items():
+    for k, v in res.scene_result.items():
         out.write(f"  {k}: {v}\n")
 
 
 def cmd_run(a) -> int:
-    from .scenario import load_scenario
-    from .simulation import Simulation
+    from .loader import load_scenario
+    from .runner import simulation_for
 
     sc = load_scenario(a.scenario, a.set)
-    sim = Simulation(sc, device=a.device)
+    sim = simulation_for(sc, device=a.device)
     with StopRequest() as stop:
         prog = Progress(sc.time.end, stop=stop, quiet=a.quiet)
         try:
@@ -111,12 +111,12 @@ def cmd_run(a) -> int:
         print(f"mpm-warp: stopped at t = {res.sim_time:.6g} s on request{where}", file=sys.stderr)
         return 130
     if a.json:
-        print(json.dumps(res.__dict__, default=str))
+        print(json.dumps({k: v for k, v in res.__dict__.items() if k != "monitors"}, default=str))
     return 0
 
 
 def cmd_resume(a) -> int:
-    from .simulation import resume
+    from .runner import resume
 
     res = resume(a.run, device=a.device, end_time=a.end)
     _summary(res)
@@ -124,16 +124,15 @@ def cmd_resume(a) -> int:
 
 
 def cmd_scenes(a) -> int:
-    from .scenario import list_scenes, read_scenario_dict
+    from .loader import list_scenes, load_scenario
 
     for name in list_scenes():
-        raw, _ = read_scenario_dict(name)
-        print(f"{name:20s} {raw.get('description', '')}")
+        print(f"{name:20s} {load_scenario(name).description}")
     return 0
 
 
 def cmd_info(a) -> int:
-    from .simulation import versions
+    from .result import versions
 
     print(json.dumps(versions(), indent=1))
     return 0

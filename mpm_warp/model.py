@@ -16,11 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from .config import Scenario
 from .kernels.camclay import SINGULAR_VALUE_FLOOR
 from .kernels.grid_update import wall_struct
 from .kernels.types import mat33, vec3
 from .materials import CamClaySnow, Elastic
-from .scenario import Scenario
 
 __all__ = ["Model", "State", "ParticleGroup", "seed_block", "velocity_gradient", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
 

@@ -25,8 +25,8 @@ import re
 import numpy as np
 
 from .errors import InvalidArgument
-from .fronts import steady_speed
 from .io import RunData, read_run
+from .scenes.fronts import steady_speed
 
 __all__ = ["fit_front_speed", "plot_run", "plot_front", "plot_markers", "plot_shear", "plot_energy", "add_cli"]
 

@@ -9,74 +9,26 @@ from __future__ import annotations
 
 import math
 import os
-import platform
 import time as _time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 import warp as wp
 
 from . import io
+from .config import OUTPUT_FIELDS, Scenario
 from .device import resolve_device
-from .errors import InvalidArgument, SimulationBlowUp
-from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_invariants_kernel
-from .model import SINGULAR_VALUE_FLOOR, Model, State
-from .scenario import OUTPUT_FIELDS, Scenario
+from .errors import InvalidArgument, OutputError, SimulationBlowUp
+from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_invariants_kernel, stress_kernel
+from .model import SINGULAR_VALUE_FLOOR, Model, ParticleGroup, State
+from .monitor import GroupState, Monitor
+from .result import RunResult, versions
 from .step import Stepper
 
-__all__ = ["Simulation", "RunResult", "versions"]
+__all__ = ["Simulation"]
 
 #: a particle may not move more than this many cells in one step (health check)
 MAX_CELLS_PER_STEP = 1.0
-
-
-def versions() -> dict[str, str]:
-    """Versions of the library and its main dependencies."""
-    import h5py
-
-    from . import __version__
-
-    return {"mpm_warp": __version__, "warp": wp.config.version, "numpy": np.__version__, "h5py": h5py.__version__,
-            "python": platform.python_version()}
-
-
-@dataclass
-class RunResult:
-    """What a run returns.
-
-    Attributes
-    ----------
-    output : str or None
-        Path of the HDF5 file.
-    steps : int
-        Steps taken in this call.
-    frames : int
-        Frames written in this call.
-    sim_time : float
-        Simulated time reached (s).
-    wall_time : float
-        Wall-clock time of the stepping (s), compilation excluded.
-    particle_steps_per_s : float
-        ``n_particles * steps / wall_time``.
-    n_particles : int
-    device : str
-    edge_hits : int
-        Particle clamps at the grid edge (see ``kernels/g2p.py``).
-    extra : dict
-        Scene diagnostics (crack speed, errors against references, ...).
-    """
-
-    output: str | None
-    steps: int
-    frames: int
-    sim_time: float
-    wall_time: float
-    particle_steps_per_s: float
-    n_particles: int
-    device: str
-    edge_hits: int = 0
-    extra: dict = field(default_factory=dict)
 
 
 class Simulation:
@@ -111,15 +63,10 @@ class Simulation:
         self.stepper = Stepper(self.model, self.state, use_graph, n_threads)
         self.frame_index = 0
         self.x0 = self.state.x.numpy().astype(np.float64)
-        #: functions ``f(sim) -> dict[str, float]`` evaluated at every frame and stored as scalar series
-        self.frame_diagnostics: list[Callable[[Simulation], dict]] = []
-        #: functions ``f(sim) -> dict`` evaluated when a run ends, merged into ``RunResult.extra``
-        self.result_hooks: list[Callable[[Simulation], dict]] = []
+        #: monitors by name (:meth:`add_monitor`)
+        self.monitors: dict[str, Monitor] = {}
         self._since_health = 0
         self._bad = wp.full(3, INT_MAX, dtype=wp.int32, device=self.device)
-        from .scenes import attach_scene
-
-        attach_scene(self)
         self._energy = wp.zeros(2, dtype=wp.float64, device=self.device)
 
     # ----------------------------------------------------------------- public
@@ -127,6 +74,37 @@ class Simulation:
     def time(self) -> float:
         """Simulated time (s)."""
         return float(self.state.clock.numpy()[0])
+
+    @property
+    def clock(self) -> wp.array:
+        """Device clock ``[t, dt, t_end]`` (float64, s), read by device actions."""
+        return self.state.clock
+
+    def add_monitor(self, monitor: Monitor) -> Monitor:
+        """Attach a monitor (:mod:`mpm_warp.monitor`): its actions run every step from the next one on."""
+        if not isinstance(monitor, Monitor):
+            raise InvalidArgument("monitor", type(monitor).__name__, "an object with the methods of "
+                                  "mpm_warp.monitor.Monitor")
+        if monitor.name in self.monitors:
+            raise InvalidArgument("monitor.name", monitor.name, f"a name not in use (used: {sorted(self.monitors)})")
+        self.monitors[monitor.name] = monitor
+        self.stepper.actions.extend(monitor.actions())
+        return monitor
+
+    def group(self, name: str) -> ParticleGroup:
+        """The particle group (range, material, mass) of the block named ``name``."""
+        for g in self.model.groups:
+            if g.name == name:
+                return g
+        raise InvalidArgument("group", name, "one of " + ", ".join(repr(g.name) for g in self.model.groups))
+
+    def group_state(self, name: str) -> GroupState:
+        """Array views of the state of group ``name`` (:class:`mpm_warp.monitor.GroupState`)."""
+        g, s = self.group(name), self.state
+        sl = slice(g.start, g.end)
+        ljp = s.log_jp[g.plastic_start:g.plastic_start + g.count] if g.plastic_start >= 0 else None
+        return GroupState(g.name, g.material, g.start, g.end, g.mass, g.vol0, s.x[sl], s.v[sl], s.C[sl], s.F[sl], ljp,
+                          self.x0[sl])
 
     def energies(self) -> dict[str, float]:
         """Kinetic and elastic energy (J) of the current state."""
@@ -156,6 +134,19 @@ class Simulation:
                       device=self.device)
         return p.numpy(), q.numpy()
 
+    def cauchy_stress(self, group: str | None = None) -> np.ndarray:
+        """Cauchy stress tensors (Pa, tension positive), (n, 3, 3), of every particle or of one group."""
+        T = self.model.T
+        groups = self.model.groups if group is None else [self.group(group)]
+        start = groups[0].start if group is not None else 0
+        out = wp.zeros(sum(g.count for g in groups), dtype=self.state.F.dtype, device=self.device)
+        for g in groups:
+            m = g.material
+            wp.launch(stress_kernel(T), g.count, inputs=[self.state.F[g.start:g.end], T(m.mu), T(m.lam),
+                                                         T(SINGULAR_VALUE_FLOOR), out[g.start - start:g.end - start]],
+                      device=self.device)
+        return out.numpy()
+
     def particle_field(self, name: str) -> np.ndarray:
         """Host copy of one output field for all particles (see ``OUTPUT_FIELDS``)."""
         s = self.state
@@ -173,6 +164,8 @@ class Simulation:
         if name in ("p", "q"):
             p, q = self.stress_invariants()
             return p if name == "p" else q
+        if name == "stress":
+            return self.cauchy_stress()
         if name == "yielded":
             out = np.zeros(n, dtype=np.uint8)
             if s.yielded is not None:
@@ -308,11 +301,11 @@ class Simulation:
             if writer is not None:
                 writer.close()
         n = self.model.n_particles
-        extra = {}
-        for hook in self.result_hooks:
-            extra.update(hook(self))
+        result = {}
+        for m in self.monitors.values():
+            result.update(m.result())
         return RunResult(output, steps_total, frames, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
-                         n, self.device, self.stepper.edge_count()[0] - edge0, extra)
+                         n, self.device, self.stepper.edge_count()[0] - edge0, result, dict(self.monitors))
 
     def _compile(self) -> None:
         """Load every kernel of the plan (compiling on first use) without stepping."""
@@ -326,14 +319,16 @@ class Simulation:
             shape, unit, _ = OUTPUT_FIELDS[name]
             dt = "uint8" if name == "yielded" else self.scenario.precision
             pf[name] = (shape, dt, unit)
+        for m in self.monitors.values():
+            for name, (shape, unit) in getattr(m, "particle_fields", dict)().items():
+                pf[name] = (shape, self.scenario.precision, unit)
         group_id = np.zeros(self.model.n_particles, dtype=np.uint8)
         for i, g in enumerate(self.model.groups):
             group_id[g.start:g.end] = i
         static = {"x0": (self.x0.astype(self.model.np_dtype), "m"), "group": (group_id, "1")}
         scalars = {"kinetic_energy": "J", "elastic_energy": "J"}
-        for f in self.frame_diagnostics:
-            for k, unit in getattr(f, "units", {}).items():
-                scalars[k] = unit
+        for m in self.monitors.values():
+            scalars.update(m.units())
         attrs = {
             "scenario": self.scenario.to_dict(),
             "versions": versions(),
@@ -350,6 +345,8 @@ class Simulation:
     def _write_frame(self, writer: io.RunWriter) -> None:
         t, _, steps = self.stepper.clock()
         parts = {name: self.particle_field(name) for name in self.scenario.output.fields}
+        for m in self.monitors.values():
+            parts.update({name: m.particle_field(name) for name in getattr(m, "particle_fields", dict)()})
         scalars = self.energies()
         scalars.update(self._frame_diagnostics())
         imp = self.stepper.take_wall_impulse()
@@ -360,37 +357,43 @@ class Simulation:
         writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
 
     def _frame_diagnostics(self) -> dict:
-        """Evaluate the scene's frame diagnostics (also without an output file: they may record series)."""
+        """The monitors' frame scalars (also without an output file: they may record series)."""
         out = {}
-        for f in self.frame_diagnostics:
-            out.update(f(self))
+        for m in self.monitors.values():
+            out.update(m.frame_scalars(self))
         return out
 
     def _checkpoint(self, path: str | None) -> None:
         if path is None:
             return
-        meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device}
+        meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device,
+                "monitors": sorted(self.monitors)}
         arrays = self.state.arrays()
-        arrays["vmax"] = self.stepper.vmax.numpy()  # the next step's speed bound, so resume is bit for bit
+        # the next step's speed bound, as one number (the step takes the max over the per-thread slots):
+        # a resume on another thread count or device takes the same step
+        arrays["vmax"] = np.asarray(self.stepper.vmax.numpy().max())
+        for name, m in self.monitors.items():
+            arrays.update({f"monitors/{name}/{k}": np.asarray(a) for k, a in m.state().items()})
         io.write_checkpoint(path, arrays, meta)
 
+    def restore(self, output: str) -> None:
+        """Load the last checkpoint of the run file ``output``: state, step bound, monitors, frame count.
 
-def resume(output: str, device: str | None = None, end_time: float | None = None,
-           callback=None) -> RunResult:
-    """Continue the run stored in ``output`` from its last checkpoint.
-
-    The run file is truncated to the checkpoint's frame and extended; on the
-    CPU a resumed run matches an uninterrupted one bit for bit.
-    """
-    arrays, meta = io.read_checkpoint(io.checkpoint_path_for(output))
-    sc = Scenario.from_dict(meta["scenario"], source=output)
-    sim = Simulation(sc, device=device)
-    sim.state.load_arrays(arrays)
-    if "vmax" in arrays:
-        sim.stepper.vmax.assign(arrays["vmax"])
-    else:
-        sim.stepper.seed_vmax()
-    sim.frame_index = int(meta["frame_index"])
-    run = io.read_run(output)
-    sim.x0 = run.static["x0"].astype(np.float64)
-    return sim.run(output, end_time=end_time, callback=callback, append=True)
+        Attach the same monitors first (their state is restored into them); on the CPU the run then
+        continues bit for bit as if never stopped.
+        """
+        ckpt = io.checkpoint_path_for(output)
+        arrays, meta = io.read_checkpoint(ckpt)
+        if set(meta.get("monitors", [])) != set(self.monitors):
+            raise OutputError(f"{ckpt}: holds the state of the monitors {sorted(meta.get('monitors', []))}, "
+                              f"this simulation has {sorted(self.monitors)}")
+        self.state.load_arrays(arrays)
+        if "vmax" in arrays:
+            self.stepper.vmax.fill_(float(np.max(arrays["vmax"])))
+        else:
+            self.stepper.seed_vmax()
+        for name, m in self.monitors.items():
+            prefix = f"monitors/{name}/"
+            m.load_state({k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)})
+        self.frame_index = int(meta["frame_index"])
+        self.x0[...] = io.read_run(output).static["x0"]

@@ -49,7 +49,7 @@ import numpy as np
 
 from . import io
 from .errors import InvalidArgument, MPMError
-from .scenario import Scenario, _split, apply_overrides, read_scenario_dict
+from .loader import TOP_LEVEL_KEYS, apply_overrides, read_scenario_dict, scenario_from_dict, split_override
 
 __all__ = ["SweepResult", "run_sweep", "expand_cases", "read_cases", "parse_vary", "split_values",
            "default_workers", "plot_summary", "add_cli"]
@@ -57,7 +57,6 @@ __all__ = ["SweepResult", "run_sweep", "expand_cases", "read_cases", "parse_vary
 #: RunResult fields copied into each record and summary row
 RESULT_FIELDS = ("steps", "frames", "sim_time", "wall_time", "particle_steps_per_s", "n_particles", "device",
                  "edge_hits")
-_SECTIONS = {"name", "description", "precision", "domain", "time", "materials", "blocks", "walls", "output", "scene"}
 
 
 @dataclass
@@ -138,7 +137,7 @@ def _parse(value):
 
 def _full_key(raw: dict, key: str) -> str:
     head = key.split(".")[0]
-    if head not in _SECTIONS and isinstance(raw.get("scene"), dict) and head in raw["scene"]:
+    if head not in TOP_LEVEL_KEYS and isinstance(raw.get("scene"), dict) and head in raw["scene"]:
         return "scene." + key
     return key
 
@@ -210,15 +209,13 @@ def _run_case(task: dict) -> dict:
     try:
         from distributed import get_worker
 
-        from . import run
-        from .scenes import expand_scene
+        from .runner import run
 
         rec["worker"] = get_worker().address
-        raw = expand_scene(apply_overrides(task["raw"], dict(task["overrides"])), task["source"])
-        scenario = Scenario.from_dict(raw, source=task["source"])
-        res = (task["runner"] or run)(scenario, out + ".part.h5", _worker_device(task["device"]))
+        scenario = scenario_from_dict(apply_overrides(task["raw"], dict(task["overrides"])), task["source"])
+        res = (task["runner"] or run)(scenario, out + ".part.h5", device=_worker_device(task["device"]))
         data = io.read_run(out + ".part.h5")
-        rec.update(status="ok", result={k: getattr(res, k) for k in RESULT_FIELDS}, extra=dict(res.extra),
+        rec.update(status="ok", result={k: getattr(res, k) for k in RESULT_FIELDS}, extra=dict(res.scene_result),
                    final={k: float(v[-1]) for k, v in data.scalars.items() if len(v)}, n_frames=data.n_frames)
         if os.path.exists(io.checkpoint_path_for(out + ".part.h5")):
             os.replace(io.checkpoint_path_for(out + ".part.h5"), io.checkpoint_path_for(out + ".h5"))
@@ -328,7 +325,7 @@ def run_sweep(scenario, vary: dict | None = None, cases=None, out_dir="sweep", *
     if n_workers is not None and (not isinstance(n_workers, int) or n_workers < 1):
         raise InvalidArgument("n_workers", n_workers, "an integer >= 1")
     raw, source = read_scenario_dict(os.fspath(scenario))
-    pairs = overrides.items() if isinstance(overrides, dict) else [_split(o) for o in overrides or ()]
+    pairs = overrides.items() if isinstance(overrides, dict) else [split_override(o) for o in overrides or ()]
     fixed = [(_full_key(raw, k), _parse(v)) for k, v in pairs]
     case_list = expand_cases(vary, cases)
     os.makedirs(out_dir, exist_ok=True)

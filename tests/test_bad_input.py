@@ -238,7 +238,7 @@ def test_nan_and_inf(tmp_path, text, field, value):
                  id="unknown-material-name"),
     pytest.param(_sub("hi = [0.2, 0.08, 0.04]", "hi = [0.6, 0.08, 0.04]"), "blocks[0].lo/hi[0]", "0.6",
                  id="block-outside-domain"),
-    pytest.param(_sub('fields = ["x", "v", "p", "q"]', 'fields = ["x", "stress"]'), "output.fields", "'stress'",
+    pytest.param(_sub('fields = ["x", "v", "p", "q"]', 'fields = ["x", "rho"]'), "output.fields", "'rho'",
                  id="unknown-output-field"),
     pytest.param(_sub("checkpoint_every = 5", "checkpoint_every = -1"), "output.checkpoint_every", "-1",
                  id="negative-checkpoint-every"),
@@ -259,8 +259,8 @@ def test_unknown_material_model_lists_the_models(tmp_path):
 
 
 def test_unknown_output_field_lists_the_fields(tmp_path):
-    _expect(tmp_path, _sub('fields = ["x", "v", "p", "q"]', 'fields = ["x", "stress"]'), mw.InvalidArgument,
-            "'stress'", "'log_jp'", "'yielded'")
+    _expect(tmp_path, _sub('fields = ["x", "v", "p", "q"]', 'fields = ["x", "rho"]'), mw.InvalidArgument,
+            "'rho'", "'log_jp'", "'yielded'")
 
 
 def test_camclay_parameters_checked(tmp_path):
@@ -352,7 +352,7 @@ def _one_line(text: str) -> str:
                  id="unknown-model"),
     pytest.param(_sub("hi = [0.2, 0.08, 0.04]", "hi = [0.6, 0.08, 0.04]"), [], ("blocks[0].lo/hi[0]",),
                  id="outside"),
-    pytest.param(_sub('fields = ["x", "v", "p", "q"]', 'fields = ["x", "stress"]'), [], ("output.fields", "'stress'"),
+    pytest.param(_sub('fields = ["x", "v", "p", "q"]', 'fields = ["x", "rho"]'), [], ("output.fields", "'rho'"),
                  id="unknown-field"),
     pytest.param(BASE, ["time.cfl=abc"], ("time.cfl", "'abc'"), id="set-bad-value"),
     pytest.param(BASE, ["nonsense"], ("'nonsense'", "key=value"), id="set-no-equals"),

@@ -6,10 +6,10 @@
 - :mod:`mpm_warp.io.hdf5`: format names and the helpers they share.
 """
 
-from .checkpoint import checkpoint_path_for, read_checkpoint, write_checkpoint
+from .checkpoint import checkpoint_path_for, read_checkpoint, read_checkpoint_meta, write_checkpoint
 from .hdf5 import CHECKPOINT_FORMAT, FORMAT, FORMAT_VERSION
 from .rundata import RunData, read_run
 from .runfile import RunWriter
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "RunWriter", "RunData", "read_run",
-           "write_checkpoint", "read_checkpoint", "checkpoint_path_for"]
+           "write_checkpoint", "read_checkpoint", "read_checkpoint_meta", "checkpoint_path_for"]

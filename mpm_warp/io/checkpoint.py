@@ -10,7 +10,7 @@ import numpy as np
 
 from .hdf5 import CHECKPOINT_FORMAT, FORMAT_VERSION, check_format, now, open_read, to_json
 
-__all__ = ["checkpoint_path_for", "write_checkpoint", "read_checkpoint"]
+__all__ = ["checkpoint_path_for", "write_checkpoint", "read_checkpoint", "read_checkpoint_meta"]
 
 
 def checkpoint_path_for(run_path) -> str:
@@ -69,3 +69,9 @@ def read_checkpoint(path) -> tuple[dict[str, np.ndarray], dict]:
                      if isinstance(obj, h5py.Dataset) else None)
         return arrays, json.loads(f.attrs["meta"])
 
+
+def read_checkpoint_meta(path) -> dict:
+    """The ``meta`` of a checkpoint alone (no arrays read); raises :class:`OutputError`."""
+    with open_read(path) as f:
+        check_format(f, CHECKPOINT_FORMAT)
+        return json.loads(f.attrs["meta"])

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
+from ..config import Block, Domain, Scenario, TimeControl
 from ..errors import MPMError
 from ..materials import Elastic
-from ..scenario import Block, Domain, Scenario, TimeControl
 from ..simulation import Simulation
 from ..stress import cauchy_stress
 from ..walls import Wall

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
+from ..config import Block, Domain, Output, Scenario, TimeControl
 from ..materials import CamClaySnow, Elastic, hardening_collapse
-from ..scenario import Block, Domain, Output, Scenario, TimeControl
 from ..simulation import Simulation
 from ..stress import kirchhoff_stress, pressure_and_mises
 from ..walls import Wall
