@@ -51,7 +51,7 @@ def slope_gravity(theta_deg: float) -> list[float]:
 
 
 def proxy_runner(scenario, output, device):
-    """Run the block and add its release speed and acceleration (m/s, m/s^2) to ``extra``."""
+    """Run the block and add its release speed and acceleration (m/s, m/s^2) to ``scene_result``."""
     res = mw.run(scenario, output, device)
     data = mw.read_run(output)
     vx = np.array([data.frame(i)["v"][:, 0].mean() for i in range(data.n_frames)], dtype=float)

@@ -11,6 +11,7 @@ import numpy as np
 from ...checks import check_choices, finite_number, positive_int
 from ...materials import hardening_collapse
 from ...walls import WallKind
+from ..fronts import fit_window
 from ..snow import Settle, Slab, check_weak_layer_cells, oedometric_pressure, slab_normal_stress
 from ..weak_layer import WeakLayer
 from .references import heierli_speed, heierli_touchdown
@@ -91,6 +92,8 @@ class PSTParams:
     """
 
     kind: ClassVar[str] = "pst"
+    #: the steady part of the self-propagation path: from 30 % to 85 % of the way from the cut to the far end
+    SPEED_FIT_FRACTIONS: ClassVar[tuple[float, float]] = (0.3, 0.85)
     dx: float = 0.01
     particles_per_cell: int = 2
     length: float = 4.0
@@ -176,9 +179,8 @@ class PSTParams:
         return np.asarray(x, dtype=float) if self.saw.from_end == "left" else self.length - np.asarray(x, dtype=float)
 
     def speed_fit_window(self) -> tuple[float, float]:
-        """Steady part of the self-propagation path (m from the cut end): 30 % to 85 % of the way from the cut."""
-        cut = float(self.saw.cut_length)
-        return cut + 0.3 * (self.length - cut), cut + 0.85 * (self.length - cut)
+        """Steady part of the self-propagation path (m from the cut end), :data:`SPEED_FIT_FRACTIONS` of the way."""
+        return fit_window(float(self.saw.cut_length), float(self.length), *self.SPEED_FIT_FRACTIONS)
 
     def references(self) -> dict[str, float]:
         """Closed-form references of this PST (``mpm_warp.scenes.pst.references``).
