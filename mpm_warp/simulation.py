@@ -47,6 +47,8 @@ class Simulation:
         or more; ``MPM_WARP_THREADS`` overrides). Results depend on the thread
         count at round-off level only (the order grid copies are summed in).
 
+    A snow scene's saw, push and diagnostics are its monitor, attached by :func:`mpm_warp.run`.
+
     Examples
     --------
     >>> sim = Simulation(load_scenario("elastic_block"))          # doctest: +SKIP
@@ -83,8 +85,7 @@ class Simulation:
     def add_monitor(self, monitor: Monitor) -> Monitor:
         """Attach a monitor (:mod:`mpm_warp.monitor`): its actions run every step from the next one on."""
         if not isinstance(monitor, Monitor):
-            raise InvalidArgument("monitor", type(monitor).__name__, "an object with the methods of "
-                                  "mpm_warp.monitor.Monitor")
+            raise InvalidArgument("monitor", type(monitor).__name__, "an mpm_warp.monitor.Monitor")
         if monitor.name in self.monitors:
             raise InvalidArgument("monitor.name", monitor.name, f"a name not in use (used: {sorted(self.monitors)})")
         self.monitors[monitor.name] = monitor

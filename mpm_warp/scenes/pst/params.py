@@ -175,7 +175,7 @@ class PSTParams:
         return np.asarray([float(m) for m in np.arange(0.5 * self.marker_spacing, self.length, self.marker_spacing)])
 
     def distance_from_cut_end(self, x):
-        """Distance (m) of positions ``x`` (m) from the end the saw starts at."""
+        """Distance (m) of positions ``x`` (m) from the end the saw starts at (its own inverse: distance to x)."""
         return np.asarray(x, dtype=float) if self.saw.from_end == "left" else self.length - np.asarray(x, dtype=float)
 
     def speed_fit_window(self) -> tuple[float, float]:
