@@ -34,6 +34,7 @@ __all__ = [
     "camclay_p0_func",
     "camclay_pq_func",
     "camclay_return_func",
+    "camclay_return_strain_func",
     "camclay_yield_func",
     "initial_log_jp",
 ]
@@ -256,15 +257,42 @@ def camclay_return_func(T):
     """
     v3 = vec3(T)
     s_floor = SINGULAR_VALUE_FLOOR
+    core = camclay_return_strain_func(T)
+
+    @wp.func
+    def camclay_return(sig: v3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T):
+        sf = T(s_floor)
+        eps = v3(wp.log(wp.max(sig[0], sf)), wp.log(wp.max(sig[1], sf)), wp.log(wp.max(sig[2], sf)))
+        eps_new, log_jp_new, y = core(eps, log_jp, mu, lam, M, beta, xi, p0_floor)
+        if y == 0:
+            return sig, log_jp, y
+        return v3(wp.exp(eps_new[0]), wp.exp(eps_new[1]), wp.exp(eps_new[2])), log_jp_new, y
+
+    return camclay_return
+
+
+@functools.cache
+def camclay_return_strain_func(T):
+    """Build the return mapping in principal Hencky strains, the core of :func:`camclay_return_func`.
+
+    Signature of the returned ``wp.func``::
+
+        camclay_return_strain(eps: vec3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T,
+                              p0_floor: T) -> (eps_new: vec3, log_jp_new: T, yielded: int32)
+
+    ``eps`` are the principal Hencky strains of the trial (-), e.g. ``ln s`` or, with
+    full relative precision for small strains, ``1/2 log1p(lambda)`` of the
+    eigenvalues ``lambda`` of ``F F^T - I`` (``kernels/constitutive.py``). Everything
+    else as :func:`camclay_return_func`; an elastic trial returns ``eps`` itself.
+    """
+    v3 = vec3(T)
     sqrt6 = _SQRT6
     yield_fn = camclay_yield_func(T)
     p0_fn = camclay_p0_func(T)
     closest = _ellipse_closest_func(T)
 
     @wp.func
-    def camclay_return(sig: v3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T):
-        sf = T(s_floor)
-        eps = v3(wp.log(wp.max(sig[0], sf)), wp.log(wp.max(sig[1], sf)), wp.log(wp.max(sig[2], sf)))
+    def camclay_return_strain(eps: v3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T):
         tr = eps[0] + eps[1] + eps[2]
         m = tr / T(3.0)
         dev = v3(eps[0] - m, eps[1] - m, eps[2] - m)
@@ -275,7 +303,7 @@ def camclay_return_func(T):
         q_tr = T(sqrt6) * mu * wp.length(dev)
         p0 = p0_fn(log_jp, K, xi, p0_floor)
         if yield_fn(p_tr, q_tr, p0, M, beta) <= T(0.0):
-            return sig, log_jp, wp.int32(0)
+            return eps, log_jp, wp.int32(0)
 
         p_new = T(0.0)
         q_new = T(0.0)
@@ -303,9 +331,7 @@ def camclay_return_func(T):
         if q_tr > T(0.0):
             scale = wp.min(q_new / q_tr, T(1.0))
         m_new = -p_new / (T(3.0) * K)
-        sig_new = v3(
-            wp.exp(dev[0] * scale + m_new), wp.exp(dev[1] * scale + m_new), wp.exp(dev[2] * scale + m_new)
-        )
-        return sig_new, log_jp + tr - T(3.0) * m_new, wp.int32(1)
+        eps_new = v3(dev[0] * scale + m_new, dev[1] * scale + m_new, dev[2] * scale + m_new)
+        return eps_new, log_jp + tr - T(3.0) * m_new, wp.int32(1)
 
-    return camclay_return
+    return camclay_return_strain

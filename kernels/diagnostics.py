@@ -1,154 +1,131 @@
-"""Frame-time diagnostics: energies, health check and derived output fields.
+"""Frame-time diagnostics: energies, stresses, health check.
 
 None of these run inside the substep loop except the health check, which the
-driver launches every few steps.
+driver launches every few steps. Each is built per (dimension, scalar type);
+the elastic state is ``H = F_E - I`` (and ``h_zz`` in plane strain), read
+through ``kernels.constitutive.principal_func``. Energies and stresses are
+evaluated in float64 from the stored state whatever its precision (they run
+once per frame): ``I + H`` rounded to float32 would add a rounding of its own
+to the state's.
 """
 
 import functools
 
 import warp as wp
 
-from .elasticity import hencky_func
-from .types import mat33, vec3
+from .constitutive import material_struct, principal_strain_func
+from .elasticity import hencky_strain_energy_func, hencky_strain_func
+from .types import mat, vec
 
 INT_MAX = 2147483647
 
 
 @functools.cache
-def energy_kernel(T):
-    """Kinetic ``0.5 m |v|^2`` and elastic ``V0 psi(F_E)`` energy (J) of one group.
+def energy_kernel(dim, T):
+    """Kinetic ``0.5 m |v|^2`` and elastic ``V0 psi(F_E)`` energy (J; J/m in plane strain) of one group.
 
     Accumulates into ``out[0]`` (kinetic) and ``out[1]`` (elastic), float64.
     ``psi = mu |eps|^2 + lam/2 tr(eps)^2`` (Hencky, MODEL.md 1).
     """
-    V = vec3(T)
-    M = mat33(T)
-    hencky = hencky_func(T)
+    V = vec(dim, T)
+    M = mat(dim, T)
+    MD = mat(dim, wp.float64)
+    VD = vec(dim, wp.float64)
+    D = wp.float64
+    P = material_struct(T)
+    principal_strain = principal_strain_func(D, dim)
+    psi_fn = hencky_strain_energy_func(D)
 
-    @wp.kernel(enable_backward=False)
-    def energy(
-        v: wp.array(dtype=V),
-        F: wp.array(dtype=M),
-        mass: T,
-        vol0: T,
-        mu: T,
-        lam: T,
-        s_floor: T,
-        out: wp.array(dtype=wp.float64),
-    ):
+    @wp.kernel(enable_backward=False, module="unique")
+    def energy(v: wp.array(dtype=V), H: wp.array(dtype=M), hzz: wp.array(dtype=T), mass: T, vol0: T, m: P,
+               out: wp.array(dtype=wp.float64)):
         i = wp.tid()
-        U = M()
-        s = V()
-        Vt = M()
-        wp.svd3(F[i], U, s, Vt)
-        tau = hencky(s, mu, lam, s_floor)
-        eps = V(wp.log(wp.max(s[0], s_floor)), wp.log(wp.max(s[1], s_floor)), wp.log(wp.max(s[2], s_floor)))
-        # psi = 1/2 tau : eps for the quadratic Hencky energy
-        psi = T(0.5) * wp.dot(tau, eps)
-        wp.atomic_add(out, 0, wp.float64(T(0.5) * mass * wp.dot(v[i], v[i])))
-        wp.atomic_add(out, 1, wp.float64(vol0 * psi))
+        h = D(0.0)
+        if wp.static(dim == 2):
+            h = D(hzz[i])
+        U, eps, Vm, s, svd = principal_strain(MD(H[i]), h, D(m.s_floor))
+        psi = psi_fn(eps, D(m.mu), D(m.lam))
+        vi = v[i]
+        wp.atomic_add(out, 0, D(0.5) * D(mass) * wp.dot(VD(vi), VD(vi)))
+        wp.atomic_add(out, 1, D(vol0) * psi)
 
     return energy
 
 
 @functools.cache
-def stress_invariants_kernel(T):
-    """Pressure ``p = -tr(tau)/3`` and Mises ``q = sqrt(3/2)|dev tau|`` (Pa, Kirchhoff) of one group."""
-    V = vec3(T)
-    M = mat33(T)
-    hencky = hencky_func(T)
+def stress_kernel(dim, T):
+    """Cauchy stress ``sigma = tau / J_E`` (Pa, 3x3, tension positive), pressure ``p = -tr(tau)/3`` and Mises
+    ``q = sqrt(3/2)|dev tau|`` (Pa, Kirchhoff, compression positive) of one group.
 
-    @wp.kernel(enable_backward=False)
-    def stress_invariants(
-        F: wp.array(dtype=M),
-        mu: T,
-        lam: T,
-        s_floor: T,
-        p_out: wp.array(dtype=T),
-        q_out: wp.array(dtype=T),
-    ):
-        i = wp.tid()
-        U = M()
-        s = V()
-        Vt = M()
-        wp.svd3(F[i], U, s, Vt)
-        tau = hencky(s, mu, lam, s_floor)
-        p = -(tau[0] + tau[1] + tau[2]) / T(3.0)
-        dev = tau + V(p, p, p)
-        p_out[i] = p
-        q_out[i] = wp.sqrt(T(1.5) * wp.dot(dev, dev))
-
-    return stress_invariants
-
-
-@functools.cache
-def stress_kernel(T):
-    """Cauchy stress tensor ``sigma = tau / J_E`` (Pa, tension positive) of one group, per particle.
-
-    ``F_E = U diag(s) V^T`` (``wp.svd3``), ``tau = U diag(tau_i) U^T`` with the principal Hencky
-    stresses of :func:`mpm_warp.kernels.elasticity.hencky_func` (singular values floored at
-    ``s_floor``) and ``J_E = prod_i max(s_i, s_floor)`` (MODEL.md 1). The host mirror is
-    :func:`mpm_warp.stress.cauchy_stress`; normal and shear stresses on any plane follow from
-    ``sigma`` without recomputing it from ``F_E``.
+    In plane strain ``sigma`` holds the in-plane block and ``sigma_zz`` (the
+    out-of-plane stress the constraint ``F_zz = 1`` carries); ``sigma_xz =
+    sigma_yz = 0``. Any of the outputs may be None-sized arrays not written.
     """
-    V = vec3(T)
-    M = mat33(T)
-    hencky = hencky_func(T)
+    M = mat(dim, T)
+    M3 = mat(3, T)
+    D = wp.float64
+    MD = mat(dim, D)
+    V3 = vec(3, D)
+    P = material_struct(T)
+    principal_strain = principal_strain_func(D, dim)
+    hencky = hencky_strain_func(D)
 
-    @wp.kernel(enable_backward=False)
-    def stress(
-        F: wp.array(dtype=M),
-        mu: T,
-        lam: T,
-        s_floor: T,
-        sigma_out: wp.array(dtype=M),
-    ):
+    @wp.kernel(enable_backward=False, module="unique")
+    def stress(H: wp.array(dtype=M), hzz: wp.array(dtype=T), m: P, want_sigma: int,
+               p_out: wp.array(dtype=T), q_out: wp.array(dtype=T), sigma_out: wp.array(dtype=M3)):
         i = wp.tid()
-        U = M()
-        s = V()
-        Vt = M()
-        wp.svd3(F[i], U, s, Vt)
-        tau = hencky(s, mu, lam, s_floor)
-        J = wp.max(s[0], s_floor) * wp.max(s[1], s_floor) * wp.max(s[2], s_floor)
-        sigma_out[i] = U * wp.diag(tau / J) * wp.transpose(U)
+        h = D(0.0)
+        if wp.static(dim == 2):
+            h = D(hzz[i])
+        sf = D(m.s_floor)
+        U, eps, Vm, s, svd = principal_strain(MD(H[i]), h, sf)
+        tau = hencky(eps, D(m.mu), D(m.lam))
+        p = -(tau[0] + tau[1] + tau[2]) / D(3.0)
+        dev = tau + V3(p, p, p)
+        p_out[i] = T(p)
+        q_out[i] = T(wp.sqrt(D(1.5) * wp.dot(dev, dev)))
+        if want_sigma != 0:
+            J = wp.exp(eps[0] + eps[1] + eps[2])  # J_E of the floored stretches
+            sig = M3()
+            for a in range(dim):
+                for b in range(dim):
+                    acc = D(0.0)
+                    for k in range(dim):
+                        acc += U[a, k] * tau[k] * U[b, k]
+                    sig[a, b] = T(acc / J)
+            if wp.static(dim == 2):
+                sig[2, 2] = T(tau[2] / J)
+            sigma_out[i] = sig
 
     return stress
 
 
 @functools.cache
-def health_kernel(T):
+def health_kernel(dim, T):
     """Health check over all particles.
 
     Writes the smallest offending particle index per cause into ``bad``:
-    ``bad[0]`` non-finite x, v or F; ``bad[1]`` a particle moving more than
-    ``max_cells`` cells in one step (``|v| dt > max_cells dx``); ``bad[2]``
-    ``det F_E <= 0``. Entries stay ``INT_MAX`` when healthy.
+    ``bad[0]`` non-finite x, v or F_E; ``bad[1]`` a particle moving more than
+    ``max_cells`` cells in one step (``|v| dt > max_cells dx`` with ``dt`` the
+    last real step, ``clock[3]``, so the check also holds at frame ends and under
+    CUDA graphs). Entries stay ``INT_MAX`` when healthy. Inversions and
+    singular-value floor events are counted by P2G (``kernels/p2g.py``).
     """
-    V = vec3(T)
-    M = mat33(T)
+    V = vec(dim, T)
+    M = mat(dim, T)
 
-    @wp.kernel(enable_backward=False)
-    def health(
-        x: wp.array(dtype=V),
-        v: wp.array(dtype=V),
-        F: wp.array(dtype=M),
-        clock: wp.array(dtype=wp.float64),
-        dx: T,
-        max_cells: T,
-        bad: wp.array(dtype=wp.int32),
-    ):
+    @wp.kernel(enable_backward=False, module="unique")
+    def health(x: wp.array(dtype=V), v: wp.array(dtype=V), H: wp.array(dtype=M), hzz: wp.array(dtype=T),
+               clock: wp.array(dtype=wp.float64), dx: T, max_cells: T, bad: wp.array(dtype=wp.int32)):
         i = wp.tid()
-        xi = x[i]
         vi = v[i]
-        Fi = F[i]
-        finite = wp.isfinite(xi) and wp.isfinite(vi) and wp.isfinite(Fi)
+        finite = wp.isfinite(x[i]) and wp.isfinite(vi) and wp.isfinite(H[i])
+        if wp.static(dim == 2):
+            finite = finite and wp.isfinite(hzz[i])
         if not finite:
             wp.atomic_min(bad, 0, i)
             return
-        if wp.length(vi) * T(clock[1]) > max_cells * dx:
+        if wp.length(vi) * T(clock[3]) > max_cells * dx:
             wp.atomic_min(bad, 1, i)
-        # float64: a floored F (singular values down to 1e-6) has det ~ 1e-12, below float32 rounding
-        if wp.determinant(wp.mat33d(Fi)) <= wp.float64(0.0):
-            wp.atomic_min(bad, 2, i)
 
     return health

@@ -20,7 +20,8 @@ import warp as wp
 
 from .types import vec3
 
-__all__ = ["clamp_singular_func", "hencky_func", "hencky_energy_func"]
+__all__ = ["clamp_singular_func", "hencky_func", "hencky_energy_func", "hencky_strain_func",
+           "hencky_strain_energy_func"]
 
 
 @functools.cache
@@ -93,3 +94,31 @@ def hencky_energy_func(T):
         return mu * wp.dot(eps, eps) + T(0.5) * lam * tr * tr
 
     return hencky_energy
+
+
+@functools.cache
+def hencky_strain_func(T):
+    """Build ``hencky_strain(eps, mu, lam) -> vec3``: principal Kirchhoff stresses ``2 mu eps_i + lam tr(eps)`` (Pa)
+    of principal Hencky strains ``eps`` (-) (MODEL.md section 1), the form :func:`hencky_func` takes after the log."""
+    v3 = vec3(T)
+
+    @wp.func
+    def hencky_strain(eps: v3, mu: T, lam: T):
+        tr = eps[0] + eps[1] + eps[2]
+        two_mu = T(2.0) * mu
+        return v3(two_mu * eps[0] + lam * tr, two_mu * eps[1] + lam * tr, two_mu * eps[2] + lam * tr)
+
+    return hencky_strain
+
+
+@functools.cache
+def hencky_strain_energy_func(T):
+    """Build ``hencky_strain_energy(eps, mu, lam) -> T``: ``psi = mu |eps|^2 + lam/2 tr(eps)^2`` (J/m^3)."""
+    v3 = vec3(T)
+
+    @wp.func
+    def hencky_strain_energy(eps: v3, mu: T, lam: T):
+        tr = eps[0] + eps[1] + eps[2]
+        return mu * wp.dot(eps, eps) + T(0.5) * lam * tr * tr
+
+    return hencky_strain_energy

@@ -4,64 +4,74 @@
 ``D^-1 = 4 / dx^2`` for quadratic B-splines, ``x_p += dt v_p``.
 
 Edge policy: a particle whose new position leaves the safe interior of the
-grid (where its 3x3x3 stencil still fits) is clamped to it and counted in
-``edge_count[0]``; the driver reports the count. A particle whose stencil is
-not inside the grid at all (only possible for a non-finite position) is
-skipped and counted in ``edge_count[1]``; the health check then stops the run.
-No write can go out of bounds.
+grid (where its stencil still fits) is clamped to it and counted in
+``counts[0]``; the driver reports the count. A particle whose stencil is not
+inside the grid at all (only possible for a non-finite position) is skipped and
+counted in ``counts[1]``; the health check then stops the run. No write can go
+out of bounds.
 """
 
 import functools
 
 import warp as wp
 
-from .shape import in_grid, stencil_func
-from .types import mat33, vec3
+from .shape import in_grid_func, stencil_func
+from .types import mat, vec
 
 
 @functools.cache
-def g2p_kernel(T):
-    """Build the G2P kernel (launched over all particles)."""
-    V = vec3(T)
-    M = mat33(T)
-    stencil = stencil_func(T)
+def g2p_kernel(dim, T):
+    """Build the G2P kernel (launched over all particles) for dimension ``dim`` (2 or 3)."""
+    V = vec(dim, T)
+    M = mat(dim, T)
+    Vi = wp.types.vector(dim, wp.int32)
+    stencil = stencil_func(T, dim)
+    in_grid = in_grid_func(dim)
 
-    @wp.kernel(enable_backward=False)
+    @wp.kernel(enable_backward=False, module="unique")
     def g2p(
         x: wp.array(dtype=V),
         v: wp.array(dtype=V),
         C: wp.array(dtype=M),
-        grid_v: wp.array3d(dtype=V),
+        grid_v: wp.array(dtype=V, ndim=dim),
         dt_arr: wp.array(dtype=T),
         origin: V,
         inv_dx: T,
         dx: T,
+        shape: Vi,
         x_lo: V,
         x_hi: V,
-        edge_count: wp.array(dtype=wp.int32),
+        counts: wp.array(dtype=wp.int32),
     ):
         i = wp.tid()
         dt = dt_arr[0]
         if dt <= T(0.0):
             return
         b, fx, W = stencil(x[i], origin, inv_dx)
-        if not in_grid(b, grid_v.shape[0], grid_v.shape[1], grid_v.shape[2]):
+        if not in_grid(b, shape):
             # only a non-finite position gets here (positions are clamped below)
-            wp.atomic_add(edge_count, 1, 1)
+            wp.atomic_add(counts, 1, 1)
             return
-        vn = V(T(0.0), T(0.0), T(0.0))
+        vn = V()
         B = M()
         for a in range(3):
             for c in range(3):
-                for d in range(3):
-                    w = W[a, 0] * W[c, 1] * W[d, 2]
-                    g = grid_v[b[0] + a, b[1] + c, b[2] + d]
-                    dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
+                if wp.static(dim == 2):
+                    w = W[a, 0] * W[c, 1]
+                    g = grid_v[b[0] + a, b[1] + c]
+                    dpos = (V(T(float(a)), T(float(c))) - fx) * dx
                     vn += w * g
                     B += w * wp.outer(g, dpos)
+                else:
+                    for d in range(3):
+                        w = W[a, 0] * W[c, 1] * W[d, 2]
+                        g = grid_v[b[0] + a, b[1] + c, b[2] + d]
+                        dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
+                        vn += w * g
+                        B += w * wp.outer(g, dpos)
         xn = x[i] + dt * vn
         clamped = 0
-        for a in range(3):
+        for a in range(dim):
             if xn[a] < x_lo[a]:
                 xn[a] = x_lo[a]
                 clamped = 1
@@ -69,7 +79,7 @@ def g2p_kernel(T):
                 xn[a] = x_hi[a]
                 clamped = 1
         if clamped != 0:
-            wp.atomic_add(edge_count, 0, 1)
+            wp.atomic_add(counts, 0, 1)
         v[i] = vn
         C[i] = (T(4.0) * inv_dx * inv_dx) * B
         x[i] = xn

@@ -19,7 +19,7 @@ import functools
 
 import warp as wp
 
-from .types import vec3
+from .types import vec
 
 STICKY = 0
 SLIP = 1
@@ -27,15 +27,15 @@ SEPARATE = 2
 
 
 @functools.cache
-def wall_struct(T):
-    """Kernel-side wall description for scalar type ``T``.
+def wall_struct(T, dim=3):
+    """Kernel-side wall description for scalar type ``T`` and dimension ``dim``.
 
     Fields: ``point`` (m) at t = 0, ``normal`` (unit, into the material),
     ``velocity`` (m/s) reached after ``ramp_time`` (s, linear ramp from rest;
     0 means constant from the start), ``kind`` (0 sticky, 1 slip, 2 separate),
     ``friction`` (Coulomb coefficient, -).
     """
-    V = vec3(T)
+    V = vec(dim, T)
 
     @wp.struct
     class WallParams:
@@ -50,9 +50,9 @@ def wall_struct(T):
 
 
 @functools.cache
-def wall_motion_func(T):
+def wall_motion_func(T, dim=3):
     """Return ``motion(wall, t) -> (point(t), velocity(t))`` evaluated on the device."""
-    WallParams = wall_struct(T)
+    WallParams = wall_struct(T, dim)
 
     @wp.func
     def motion(w: WallParams, t: T):
@@ -70,24 +70,48 @@ def wall_motion_func(T):
 
 
 @functools.cache
-def grid_update_kernel(T, has_walls: bool):
-    """Build the grid update kernel (launched over all nodes, or a slab of them).
+def grid_update_kernel(dim, T, has_walls: bool):
+    """Build the grid update kernel (launched over all nodes, or a slab of them) for dimension ``dim``.
 
     ``grid_m`` / ``grid_p`` have a leading axis of grid copies: on the CPU each
     thread scatters into its own copy and this kernel sums them (one copy on
     CUDA). ``grid_p[0]`` holds the summed nodal momentum (kg m/s) on entry
     and the velocity (m/s) on exit. The launch covers nodes ``i0 + tid``
     along x. ``vmax[0]`` receives the largest nodal speed (m/s), used by the
-    automatic time step of the next step.
+    automatic time step of the next step. Wall impulses (N s; N s/m in plane
+    strain) are summed in float64: up to a million atomic adds per frame.
     """
-    V = vec3(T)
-    WallParams = wall_struct(T)
-    motion = wall_motion_func(T)
+    V = vec(dim, T)
+    VD = vec(dim, wp.float64)
+    Vi = wp.types.vector(dim, wp.int32)
+    WallParams = wall_struct(T, dim)
+    motion = wall_motion_func(T, dim)
 
-    @wp.kernel(enable_backward=False)
+    @wp.func
+    def node_sum(grid_m: wp.array(dtype=T, ndim=dim + 1), grid_p: wp.array(dtype=V, ndim=dim + 1), n: Vi):
+        """Mass and momentum of node ``n`` summed over the grid copies."""
+        m = T(0.0)
+        mom = V()
+        for c in range(grid_m.shape[0]):
+            if wp.static(dim == 2):
+                m += grid_m[c, n[0], n[1]]
+                mom += grid_p[c, n[0], n[1]]
+            else:
+                m += grid_m[c, n[0], n[1], n[2]]
+                mom += grid_p[c, n[0], n[1], n[2]]
+        return m, mom
+
+    @wp.func
+    def node_store(grid_p: wp.array(dtype=V, ndim=dim + 1), n: Vi, vel: V):
+        if wp.static(dim == 2):
+            grid_p[0, n[0], n[1]] = vel
+        else:
+            grid_p[0, n[0], n[1], n[2]] = vel
+
+    @wp.kernel(enable_backward=False, module="unique")
     def grid_update(
-        grid_m: wp.array4d(dtype=T),
-        grid_p: wp.array4d(dtype=V),
+        grid_m: wp.array(dtype=T, ndim=dim + 1),
+        grid_p: wp.array(dtype=V, ndim=dim + 1),
         i0: int,
         dt_arr: wp.array(dtype=T),
         clock: wp.array(dtype=wp.float64),
@@ -99,21 +123,22 @@ def grid_update_kernel(T, has_walls: bool):
         origin: V,
         dx: T,
         walls: wp.array(dtype=WallParams),
-        wall_impulse: wp.array(dtype=V),
+        wall_impulse: wp.array(dtype=VD),
         vmax: wp.array(dtype=T),
     ):
-        ii, j, k = wp.tid()
-        i = ii + i0
+        n = Vi()
+        if wp.static(dim == 2):
+            ii, j = wp.tid()
+            n = Vi(ii + i0, j)
+        else:
+            ii, j, k = wp.tid()
+            n = Vi(ii + i0, j, k)
         dt = dt_arr[0]
         if dt <= T(0.0):
             return
-        m = grid_m[0, i, j, k]
-        mom = grid_p[0, i, j, k]
-        for c in range(1, grid_m.shape[0]):
-            m += grid_m[c, i, j, k]
-            mom += grid_p[c, i, j, k]
+        m, mom = node_sum(grid_m, grid_p, n)
         if m <= mass_threshold:
-            grid_p[0, i, j, k] = V(T(0.0), T(0.0), T(0.0))
+            node_store(grid_p, n, V())
             return
         t = T(clock[0])
         g_scale = T(1.0)
@@ -123,30 +148,32 @@ def grid_update_kernel(T, has_walls: bool):
         if t < damping_until:
             vel = vel * wp.max(T(1.0) - damping * dt, T(0.0))
         if wp.static(has_walls):
-            xn = origin + V(T(i), T(j), T(k)) * dx
+            xn = V()
+            for a in range(dim):
+                xn[a] = origin[a] + T(n[a]) * dx
             for w in range(walls.shape[0]):
                 wall = walls[w]
                 pw, vw = motion(wall, t + dt)
-                n = wall.normal
+                nrm = wall.normal
                 # nodes on the plane belong to the wall; the 1e-3 dx margin absorbs the rounding of origin + i dx
-                if wp.dot(xn - pw, n) <= T(1.0e-3) * dx:
+                if wp.dot(xn - pw, nrm) <= T(1.0e-3) * dx:
                     v_old = vel
                     vrel = vel - vw
-                    vn = wp.dot(vrel, n)
+                    vn = wp.dot(vrel, nrm)
                     if wall.kind == 0:
-                        vrel = V(T(0.0), T(0.0), T(0.0))
+                        vrel = V()
                     elif wall.kind == 1:
-                        vrel = vrel - vn * n
+                        vrel = vrel - vn * nrm
                     elif vn < T(0.0):
-                        vt = vrel - vn * n
+                        vt = vrel - vn * nrm
                         vt_norm = wp.length(vt)
                         if vt_norm <= -wall.friction * vn:
-                            vrel = V(T(0.0), T(0.0), T(0.0))
+                            vrel = V()
                         else:
                             vrel = vt * (T(1.0) + wall.friction * vn / vt_norm)
                     vel = vw + vrel
-                    wp.atomic_add(wall_impulse, w, m * (v_old - vel))
-        grid_p[0, i, j, k] = vel
+                    wp.atomic_add(wall_impulse, w, VD(m * (v_old - vel)))
+        node_store(grid_p, n, vel)
         wp.atomic_max(vmax, 0, wp.length(vel))
 
     return grid_update

@@ -3,144 +3,120 @@
 One launch per particle group (a block of one material). Per particle, in
 physical order:
 
-1. trial elastic deformation gradient ``F_tr = (I + dt C) F_E`` (MODEL.md 4);
-2. Hencky strain ``eps = 1/2 log(F F^T)`` by its series when the strain is
-   small and, for Cam-Clay, the state inside the yield surface (no SVD:
-   ``kernels/logstrain.py``);
-3. otherwise the SVD ``F_tr = U diag(s) V^T``, the singular-value floor and,
-   for plastic groups only, the Cam-Clay return;
-4. Kirchhoff stress ``tau = 2 mu eps + lam tr(eps) I`` (= ``U diag(2 mu ln s +
-   lam tr ln s) U^T``);
-5. scatter of mass and of the MLS-MPM momentum
-   ``m v + (m C - dt V0 D^-1 tau) (x_i - x_p)``, ``D^-1 = 4 / dx^2``.
+1. trial elastic state ``H_tr = H + L + L H``, ``L = dt C`` (``F_tr = (I + dt C) F_E``,
+   MODEL.md 4) and the material's constitutive update, which returns the new
+   elastic state and the Kirchhoff stress ``tau`` (``kernels/constitutive.py``);
+2. scatter of mass and of the MLS-MPM momentum
+   ``m v + (m C - dt V0 D^-1 tau) (x_i - x_p)``, ``D^-1 = 4 / dx^2``, to the
+   ``3^dim`` nodes of the quadratic B-spline stencil.
+
+In plane strain (``dim = 2``) positions are 2-vectors, the grid is 2D and the
+particle volume ``V0`` and mass are per unit depth (m^3/m, kg/m).
+
+Counters (``counts``, int32, per grid copy): ``[1]`` particles skipped with a
+stencil outside the grid (only a non-finite position), ``[2]`` singular-value
+floor events, ``[3]`` inversions (``det F_tr <= 0``).
 """
 
 import functools
-import math
 
 import warp as wp
 
-from .camclay import camclay_p0_func, camclay_return_func, camclay_yield_func
-from .elasticity import clamp_singular_func, hencky_func
-from .logstrain import log_strain_func
-from .shape import in_grid, stencil_func
-from .types import mat33, vec3
-
-SQRT6 = math.sqrt(6.0)
+from .constitutive import FLOORED, INVERTED, YIELDED, constitutive_update_func, material_struct, trial_func
+from .shape import in_grid_func, stencil_func
+from .types import mat, vec
 
 
 @functools.cache
-def p2g_kernel(T, plastic: bool, track_yield: bool):
+def p2g_kernel(dim, T, model, track_yield):
     """Build the P2G kernel.
 
     Parameters
     ----------
+    dim : {2, 3}
+        Spatial dimension (2: plane strain).
     T : warp scalar type
         ``wp.float32`` or ``wp.float64``.
-    plastic : bool
-        Compile the Cam-Clay return (``log_jp`` is read and written).
+    model : str
+        Material model of the group (see ``kernels.constitutive.MODELS``); plastic
+        models read and write ``log_jp``.
     track_yield : bool
         Also set ``yielded[i] = 1`` where the return was active (output field).
     """
-    V = vec3(T)
-    M = mat33(T)
-    stencil = stencil_func(T)
-    hencky = hencky_func(T)
-    clamp_sv = clamp_singular_func(T)
-    camclay = camclay_return_func(T)
-    camclay_p0 = camclay_p0_func(T)
-    camclay_yield = camclay_yield_func(T)
-    log_strain = log_strain_func(T)
+    V = vec(dim, T)
+    M = mat(dim, T)
+    Vi = wp.types.vector(dim, wp.int32)
+    P = material_struct(T)
+    stencil = stencil_func(T, dim)
+    in_grid = in_grid_func(dim)
+    trial = trial_func(T, dim)
+    update = constitutive_update_func(dim, T, model)
+    plastic = model != "elastic"
 
-    @wp.kernel(enable_backward=False)
+    @wp.kernel(enable_backward=False, module="unique")
     def p2g(
         x: wp.array(dtype=V),
         v: wp.array(dtype=V),
         C: wp.array(dtype=M),
-        F: wp.array(dtype=M),
+        H: wp.array(dtype=M),
+        hzz: wp.array(dtype=T),
         log_jp: wp.array(dtype=T),
         yielded: wp.array(dtype=wp.uint8),
         mass: T,
         vol0: T,
-        mu: T,
-        lam: T,
-        M_csl: T,
-        beta: T,
-        xi: T,
-        p0_floor: T,
-        s_floor: T,
+        m: P,
         dt_arr: wp.array(dtype=T),
         origin: V,
         inv_dx: T,
         dx: T,
-        grid_m: wp.array3d(dtype=T),
-        grid_p: wp.array3d(dtype=V),
-        lost: wp.array(dtype=wp.int32),
+        shape: Vi,
+        grid_m: wp.array(dtype=T, ndim=dim),
+        grid_p: wp.array(dtype=V, ndim=dim),
+        counts: wp.array(dtype=wp.int32),
     ):
         i = wp.tid()
         dt = dt_arr[0]
         if dt <= T(0.0):
             return
-        xp = x[i]
         Cp = C[i]
-        F_tr = (wp.identity(3, dtype=T) + dt * Cp) * F[i]
-        # fast path: small elastic strain, Hencky stress from the log series (no SVD)
-        eps, ok = log_strain(F_tr)
-        tr_eps = wp.trace(eps)
+        H_tr = trial(H[i], dt * Cp)
+        lj = T(0.0)
         if wp.static(plastic):
-            if ok != 0:
-                K = lam + T(2.0 / 3.0) * mu
-                dev = eps - (tr_eps / T(3.0)) * wp.identity(3, dtype=T)
-                q = T(SQRT6) * mu * wp.sqrt(wp.ddot(dev, dev))
-                p0 = camclay_p0(log_jp[i], K, xi, p0_floor)
-                if camclay_yield(-K * tr_eps, q, p0, M_csl, beta) > T(0.0):
-                    ok = 0
-        tau = T(2.0) * mu * eps + (lam * tr_eps) * wp.identity(3, dtype=T)
-        if ok != 0:
-            F[i] = F_tr
+            lj = log_jp[i]
+        if wp.static(dim == 2):
+            H_new, hzz_new, tau, lj_new, flags = update(H_tr, hzz[i], lj, m)
+            hzz[i] = hzz_new
         else:
-            # general path: SVD, singular-value floor, Cam-Clay return
-            U = M()
-            s = V()
-            Vt = M()
-            wp.svd3(F_tr, U, s, Vt)
-            s_new = clamp_sv(s, s_floor)
-            changed = int(0)
-            floored = int(0)
-            if s_new[2] != s[2]:
-                changed = 1
-                floored = 1
+            H_new, tau, lj_new, flags = update(H_tr, lj, m)
+        H[i] = H_new
+        if flags != 0:
             if wp.static(plastic):
-                s_ret, ljp, y = camclay(s_new, log_jp[i], mu, lam, M_csl, beta, xi, p0_floor)
-                s_new = s_ret
-                log_jp[i] = ljp
-                changed = changed | int(y)
-                if wp.static(track_yield):
-                    if y != 0:
+                if (flags & YIELDED) != 0:
+                    log_jp[i] = lj_new
+                    if wp.static(track_yield):
                         yielded[i] = wp.uint8(1)
-            if floored != 0:
-                F[i] = U * wp.diag(s_new) * wp.transpose(Vt)
-            elif changed != 0:
-                # U diag(s_new) V^T written as a correction of F_tr: rebuilding from the float32 SVD factors
-                # puts round-off back outside the yield surface and ratchets a settled layer (creep)
-                r = V((s_new[0] - s[0]) / s[0], (s_new[1] - s[1]) / s[1], (s_new[2] - s[2]) / s[2])
-                F[i] = F_tr + F_tr * (Vt * wp.diag(r) * wp.transpose(Vt))
-            else:
-                F[i] = F_tr
-            tau_p = hencky(s_new, mu, lam, s_floor)
-            tau = U * wp.diag(tau_p) * wp.transpose(U)
+            if (flags & FLOORED) != 0:
+                wp.atomic_add(counts, 2, 1)
+            if (flags & INVERTED) != 0:
+                wp.atomic_add(counts, 3, 1)
         A = (-dt * vol0 * T(4.0) * inv_dx * inv_dx) * tau + mass * Cp
         mv = mass * v[i]
-        b, fx, W = stencil(xp, origin, inv_dx)
-        if not in_grid(b, grid_m.shape[0], grid_m.shape[1], grid_m.shape[2]):
-            wp.atomic_add(lost, 0, 1)
+        b, fx, W = stencil(x[i], origin, inv_dx)
+        if not in_grid(b, shape):
+            wp.atomic_add(counts, 1, 1)
             return
         for a in range(3):
             for c in range(3):
-                for d in range(3):
-                    w = W[a, 0] * W[c, 1] * W[d, 2]
-                    dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
-                    wp.atomic_add(grid_m, b[0] + a, b[1] + c, b[2] + d, w * mass)
-                    wp.atomic_add(grid_p, b[0] + a, b[1] + c, b[2] + d, w * (mv + A * dpos))
+                if wp.static(dim == 2):
+                    w = W[a, 0] * W[c, 1]
+                    dpos = (V(T(float(a)), T(float(c))) - fx) * dx
+                    wp.atomic_add(grid_m, b[0] + a, b[1] + c, w * mass)
+                    wp.atomic_add(grid_p, b[0] + a, b[1] + c, w * (mv + A * dpos))
+                else:
+                    for d in range(3):
+                        w = W[a, 0] * W[c, 1] * W[d, 2]
+                        dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
+                        wp.atomic_add(grid_m, b[0] + a, b[1] + c, b[2] + d, w * mass)
+                        wp.atomic_add(grid_p, b[0] + a, b[1] + c, b[2] + d, w * (mv + A * dpos))
 
     return p2g

@@ -1,4 +1,4 @@
-"""Quadratic B-spline interpolation stencil (3 nodes per axis).
+"""Quadratic B-spline interpolation stencil (3 nodes per axis, 3^dim nodes).
 
 For a particle at grid coordinate ``X = (x - origin) / dx`` the stencil base
 node is ``base = floor(X - 0.5)`` and the local offset ``f = X - base`` lies in
@@ -7,50 +7,63 @@ node is ``base = floor(X - 0.5)`` and the local offset ``f = X - base`` lies in
     w0 = 0.5 (1.5 - f)^2,  w1 = 0.75 - (f - 1)^2,  w2 = 0.5 (f - 0.5)^2,
 
 which sum to one and reproduce linear functions exactly (Steffen et al. 2008;
-Jiang et al. 2016, eq. 123).
+Jiang et al. 2016, eq. 123). The weight of node ``base + (a, c[, d])`` is
+``W[a, 0] W[c, 1] [W[d, 2]]``.
 """
 
 import functools
 
 import warp as wp
 
-from .types import mat33, vec3
+from .types import vec, weights
 
 
 @functools.cache
-def stencil_func(T):
-    """Return ``stencil(x, origin, inv_dx) -> (base: vec3i, fx: vec3, W: mat33)``.
+def stencil_func(T, dim=3):
+    """Return ``stencil(x, origin, inv_dx) -> (base: vec{dim}i, fx: vec, W: 3 x dim)``.
 
     ``x`` and ``origin`` in m, ``inv_dx`` in 1/m. ``fx`` is the offset of the
     particle from the base node in cells; row ``k`` of ``W`` holds the 1D
-    weights of stencil node ``base + k`` along x, y and z, so the weight of node
-    (i, j, k) is ``W[i, 0] * W[j, 1] * W[k, 2]``.
+    weights of stencil node ``base + k`` along each axis.
     """
-    V = vec3(T)
-    M = mat33(T)
+    V = vec(dim, T)
+    Wt = weights(dim, T)
+    Vi = wp.types.vector(dim, wp.int32)
 
     @wp.func
     def stencil(x: V, origin: V, inv_dx: T):
         X = (x - origin) * inv_dx
-        b = wp.vec3i(int(wp.floor(X[0] - T(0.5))), int(wp.floor(X[1] - T(0.5))), int(wp.floor(X[2] - T(0.5))))
-        fx = X - V(T(b[0]), T(b[1]), T(b[2]))
-        a = V(T(1.5), T(1.5), T(1.5)) - fx
-        c = fx - V(T(1.0), T(1.0), T(1.0))
-        d = fx - V(T(0.5), T(0.5), T(0.5))
-        w0 = T(0.5) * wp.cw_mul(a, a)
-        w1 = V(T(0.75), T(0.75), T(0.75)) - wp.cw_mul(c, c)
-        w2 = T(0.5) * wp.cw_mul(d, d)
-        W = M(w0[0], w0[1], w0[2], w1[0], w1[1], w1[2], w2[0], w2[1], w2[2])
+        b = Vi()
+        fx = V()
+        W = Wt()
+        for a in range(dim):
+            b[a] = int(wp.floor(X[a] - T(0.5)))
+            f = X[a] - T(b[a])
+            fx[a] = f
+            W[0, a] = T(0.5) * (T(1.5) - f) * (T(1.5) - f)
+            W[1, a] = T(0.75) - (f - T(1.0)) * (f - T(1.0))
+            W[2, a] = T(0.5) * (f - T(0.5)) * (f - T(0.5))
         return b, fx, W
 
     return stencil
 
 
-@wp.func
-def in_grid(b: wp.vec3i, nx: int, ny: int, nz: int):
-    """True when the 3x3x3 stencil based at node ``b`` lies inside a grid of ``nx * ny * nz`` nodes.
+@functools.cache
+def in_grid_func(dim):
+    """Return ``in_grid(base, shape) -> bool``: the 3^dim stencil based at ``base`` lies inside the grid.
 
-    Also false for the garbage index a non-finite position produces, so kernels
-    never read or write out of bounds.
+    ``shape`` is the node count per axis (``vec{dim}i``). Also false for the
+    garbage index a non-finite position produces, so kernels never read or
+    write out of bounds.
     """
-    return b[0] >= 0 and b[1] >= 0 and b[2] >= 0 and b[0] <= nx - 3 and b[1] <= ny - 3 and b[2] <= nz - 3
+    Vi = wp.types.vector(dim, wp.int32)
+
+    @wp.func
+    def in_grid(b: Vi, shape: Vi):
+        ok = True
+        for a in range(dim):
+            if b[a] < 0 or b[a] > shape[a] - 3:
+                ok = False
+        return ok
+
+    return in_grid

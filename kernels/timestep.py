@@ -15,7 +15,8 @@ import warp as wp
 def begin_step_kernel(T):
     """Build the one-thread kernel that sets the step size of the coming step.
 
-    ``clock`` (float64, s) holds ``[t, dt, t_end]``; ``dt_arr[0]`` receives ``dt`` in the
+    ``clock`` (float64, s) holds ``[t, dt, t_end, dt_last]`` (``dt_last``: the last step size
+    that was not a no-op, for the health check); ``dt_arr[0]`` receives ``dt`` in the
     kernels' scalar type. The clock stays float64 whatever the precision, so long
     runs in float32 keep exact frame times.
 
@@ -25,7 +26,7 @@ def begin_step_kernel(T):
     turns the remaining launches of a batch into no-ops.
     """
 
-    @wp.kernel(enable_backward=False)
+    @wp.kernel(enable_backward=False, module="unique")
     def begin_step(
         clock: wp.array(dtype=wp.float64),
         vmax: wp.array(dtype=T),
@@ -51,6 +52,7 @@ def begin_step_kernel(T):
         clock[1] = d
         dt_arr[0] = T(d)
         if d > wp.float64(0.0):  # a no-op step (frame end reached) keeps the speed bound for the next frame
+            clock[3] = d
             for k in range(vmax.shape[0]):
                 vmax[k] = T(0.0)
 
@@ -61,7 +63,7 @@ def begin_step_kernel(T):
 def end_step_kernel():
     """Build the one-thread kernel that advances the clock and the step counter."""
 
-    @wp.kernel(enable_backward=False)
+    @wp.kernel(enable_backward=False, module="unique")
     def end_step(clock: wp.array(dtype=wp.float64), steps: wp.array(dtype=wp.int64)):
         d = clock[1]
         if d > wp.float64(0.0):

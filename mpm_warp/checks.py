@@ -33,10 +33,10 @@ def finite_number(field: str, value, *, lo=None, hi=None, lo_open=False, hi_open
     return v
 
 
-def vector3(field: str, value, *, nonzero: bool = False) -> tuple[float, float, float]:
-    """Return ``value`` as a tuple of three finite floats."""
-    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)) or len(value) != 3:
-        raise InvalidArgument(field, value, "a list of 3 numbers")
+def vector(field: str, value, n: int = 3, *, nonzero: bool = False) -> tuple[float, ...]:
+    """Return ``value`` as a tuple of ``n`` finite floats (``n`` = the scene's dimension, 2 or 3)."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)) or len(value) != n:
+        raise InvalidArgument(field, value, f"a list of {n} numbers" + (" (x, y: the scene is 2D)" if n == 2 else ""))
     out = tuple(finite_number(f"{field}[{i}]", c) for i, c in enumerate(value))
     if nonzero and all(c == 0.0 for c in out):
         raise InvalidArgument(field, value, "a non-zero vector")

@@ -14,7 +14,7 @@ import json
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal, Protocol, get_args, runtime_checkable
 
-from .checks import choice, finite_number, positive_int, vector3
+from .checks import choice, finite_number, positive_int, vector
 from .errors import InvalidArgument
 from .materials import Elastic
 from .walls import WALL_KINDS, WallKind
@@ -27,15 +27,15 @@ PRECISIONS: tuple[str, ...] = get_args(Precision)
 Boundary = Literal[WallKind, "none"]
 #: conditions of the box faces: a wall kind, or "none" (no box walls)
 BOUNDARIES: tuple[str, ...] = (*WALL_KINDS, "none")
-#: particle fields the output may hold: name -> (per-particle shape, unit, description)
+#: particle fields the output may hold: name -> (per-particle shape, unit, description); "dim" is the scene's dimension
 OUTPUT_FIELDS = {
-    "x": ((3,), "m", "position"),
-    "v": ((3,), "m/s", "velocity"),
-    "F": ((3, 3), "1", "elastic deformation gradient F_E"),
+    "x": (("dim",), "m", "position"),
+    "v": (("dim",), "m/s", "velocity"),
+    "F": ((3, 3), "1", "elastic deformation gradient F_E (plane strain: in-plane block and F_zz)"),
+    "stress": ((3, 3), "Pa", "Cauchy stress tensor, tension positive (plane strain: in-plane block and sigma_zz)"),
     "log_jp": ((), "1", "ln det F_P (0 for elastic particles)"),
     "p": ((), "Pa", "pressure -tr(tau)/3, Kirchhoff, compression positive"),
     "q": ((), "Pa", "Mises stress sqrt(3/2)|dev tau|, Kirchhoff"),
-    "stress": ((3, 3), "Pa", "Cauchy stress sigma = tau / J_E, tension positive"),
     "yielded": ((), "1", "1 where the Cam-Clay return was active during the frame"),
 }
 
@@ -58,12 +58,12 @@ class Block:
     ----------
     material : str
         Name of a material of the scenario.
-    lo, hi : (3,) float
+    lo, hi : (dim,) float
         Corners of the box (m).
-    velocity : (3,) float or callable
-        Initial velocity (m/s); in Python a function ``f(x: (n, 3)) -> (n, 3)`` also works.
+    velocity : (dim,) float, callable or None
+        Initial velocity (m/s); in Python a function ``f(x: (n, dim)) -> (n, dim)`` also works; None = at rest.
     particles_per_cell : int
-        Particles per cell and axis, 1-8 (2 gives 8 per cell in 3D).
+        Particles per cell and axis, 1-8 (2 gives 8 per cell in 3D, 4 in 2D).
     name : str
         Label of the block (its particle group).
     """
@@ -71,7 +71,7 @@ class Block:
     material: str
     lo: tuple
     hi: tuple
-    velocity: Any = (0.0, 0.0, 0.0)
+    velocity: Any = None
     particles_per_cell: int = 2
     name: str = ""
 
@@ -82,7 +82,7 @@ class Domain:
 
     Attributes
     ----------
-    lo, hi : (3,) float
+    lo, hi : (dim,) float
         Box corners (m); particles must start inside.
     dx : float
         Grid spacing (m), > 0.
@@ -93,6 +93,12 @@ class Domain:
         Coulomb coefficient (-) of the box faces when ``boundary = "separate"``.
     boundary_faces : str
         Axes whose two faces carry the box condition, e.g. ``"xyz"`` or ``"z"``.
+    dimension : {2, 3}
+        3: a 3D scene. 2: plane strain in the x-y plane (true 2D kernels: a 3x3
+        stencil, 4 particles per cell at 2 per axis; the out-of-plane elastic
+        stretch is kept, so the constitutive law is the 3D one under
+        ``F_zz = 1``). In 2D every vector has two components (x, y), and masses,
+        volumes, energies and wall forces are per metre of depth.
     """
 
     lo: tuple
@@ -101,6 +107,7 @@ class Domain:
     boundary: Boundary = "slip"
     friction: float = 0.0
     boundary_faces: str = "xyz"
+    dimension: int = 3
 
 
 @dataclass(frozen=True)
@@ -119,8 +126,8 @@ class TimeControl:
         Fixed step (s); 0 selects the automatic step.
     dt_max : float
         Upper bound of the automatic step (s); 0 means none.
-    gravity : (3,) float
-        Gravitational acceleration (m/s^2); a slope is a rotated gravity.
+    gravity : (dim,) float or None
+        Gravitational acceleration (m/s^2); a slope is a rotated gravity. None: 9.81 m/s^2 along -y.
     gravity_ramp : float
         Gravity grows linearly from 0 over this time (s); 0 = full at once.
     damping : float
@@ -135,7 +142,7 @@ class TimeControl:
     cfl: float = 0.4
     dt: float = 0.0
     dt_max: float = 0.0
-    gravity: tuple = (0.0, -9.81, 0.0)
+    gravity: tuple | None = None
     gravity_ramp: float = 0.0
     damping: float = 0.0
     damping_until: float = 0.0
@@ -193,7 +200,8 @@ class Scenario:
     def validate(self) -> Scenario:
         """Check every field before any kernel runs; return a normalised copy."""
         dom = _domain(self.domain)
-        tc = _time(self.time)
+        dim = dom.dimension
+        tc = _time(self.time, dim)
         if not self.materials:
             raise InvalidArgument("materials", {}, "at least one material")
         mats = {}
@@ -204,7 +212,7 @@ class Scenario:
         blocks = tuple(_block(b, i, mats, dom) for i, b in enumerate(self.blocks))
         if not blocks:
             raise InvalidArgument("blocks", [], "at least one block of particles")
-        walls = tuple(w.validate(f"walls[{i}]") for i, w in enumerate(self.walls))
+        walls = tuple(w.validate(f"walls[{i}]", dim) for i, w in enumerate(self.walls))
         out = self.output
         if not isinstance(out.fields, (list, tuple)):
             raise InvalidArgument("output.fields", out.fields, "a list of field names, e.g. [\"x\", \"v\"]")
@@ -237,7 +245,7 @@ class Scenario:
             bd = asdict(b)
             if callable(b.velocity):
                 # a Python velocity field cannot be serialised; the state (checkpoints) carries it
-                bd["velocity"] = [0.0, 0.0, 0.0]
+                bd["velocity"] = [0.0] * self.domain.dimension
             d["blocks"].append(bd)
         if self.scene is not None:
             d["scene"] = {"kind": self.scene.kind, **self.scene.to_dict()}
@@ -245,30 +253,33 @@ class Scenario:
 
 
 def _domain(d: Domain) -> Domain:
-    lo = vector3("domain.lo", d.lo)
-    hi = vector3("domain.hi", d.hi)
-    for a in range(3):
+    dim = positive_int("domain.dimension", d.dimension, lo=2, hi=3)
+    lo = vector("domain.lo", d.lo, dim)
+    hi = vector("domain.hi", d.hi, dim)
+    for a in range(dim):
         if hi[a] <= lo[a]:
             raise InvalidArgument(f"domain.hi[{a}]", hi[a], f"a number > domain.lo[{a}] = {lo[a]:g}")
     dx = finite_number("domain.dx", d.dx, lo=0.0, lo_open=True)
-    ncell = [(hi[a] - lo[a]) / dx for a in range(3)]
-    if max(ncell) > 4096:
-        raise InvalidArgument("domain.dx", d.dx, f"a spacing giving at most 4096 cells per axis (got {max(ncell):.0f})")
+    ncell = [(hi[a] - lo[a]) / dx for a in range(dim)]
+    max_cells = 4096 if dim == 3 else 32768
+    if max(ncell) > max_cells:
+        raise InvalidArgument("domain.dx", d.dx,
+                              f"a spacing giving at most {max_cells} cells per axis (got {max(ncell):.0f})")
     choice("domain.boundary", d.boundary, BOUNDARIES)
     finite_number("domain.friction", d.friction, lo=0.0)
     if not isinstance(d.boundary_faces, str) or not set(d.boundary_faces) <= set("xyz"):
         raise InvalidArgument("domain.boundary_faces", d.boundary_faces, "letters among 'xyz'")
-    return Domain(lo, hi, dx, d.boundary, float(d.friction), d.boundary_faces)
+    return Domain(lo, hi, dx, d.boundary, float(d.friction), d.boundary_faces, dim)
 
 
-def _time(t: TimeControl) -> TimeControl:
+def _time(t: TimeControl, dim: int) -> TimeControl:
     return TimeControl(
         end=finite_number("time.end", t.end, lo=0.0, lo_open=True),
         frame_interval=finite_number("time.frame_interval", t.frame_interval, lo=0.0, lo_open=True),
         cfl=finite_number("time.cfl", t.cfl, lo=0.0, hi=1.0, lo_open=True),
         dt=finite_number("time.dt", t.dt, lo=0.0),
         dt_max=finite_number("time.dt_max", t.dt_max, lo=0.0),
-        gravity=vector3("time.gravity", t.gravity),
+        gravity=vector("time.gravity", (0.0, -9.81, 0.0)[:dim] if t.gravity is None else t.gravity, dim),
         gravity_ramp=finite_number("time.gravity_ramp", t.gravity_ramp, lo=0.0),
         damping=finite_number("time.damping", t.damping, lo=0.0),
         damping_until=finite_number("time.damping_until", t.damping_until, lo=0.0))
@@ -278,15 +289,17 @@ def _block(b: Block, i: int, mats: dict, dom: Domain) -> Block:
     w = f"blocks[{i}]"
     if b.material not in mats:
         raise InvalidArgument(f"{w}.material", b.material, "one of " + ", ".join(map(repr, mats)))
-    blo = vector3(f"{w}.lo", b.lo)
-    bhi = vector3(f"{w}.hi", b.hi)
+    dim = dom.dimension
+    blo = vector(f"{w}.lo", b.lo, dim)
+    bhi = vector(f"{w}.hi", b.hi, dim)
     lo, hi, dx = dom.lo, dom.hi, dom.dx
-    for a in range(3):
+    for a in range(dim):
         if bhi[a] <= blo[a]:
             raise InvalidArgument(f"{w}.hi[{a}]", bhi[a], f"a number > {w}.lo[{a}] = {blo[a]:g}")
         if blo[a] < lo[a] - 1e-9 * dx or bhi[a] > hi[a] + 1e-9 * dx:
             raise InvalidArgument(f"{w}.lo/hi[{a}]", (blo[a], bhi[a]),
                                   f"inside the domain [{lo[a]:g}, {hi[a]:g}] (particles inside the grid)")
     ppc = positive_int(f"{w}.particles_per_cell", b.particles_per_cell, lo=1, hi=8)
-    vel = b.velocity if callable(b.velocity) else vector3(f"{w}.velocity", b.velocity)
+    vel = b.velocity if callable(b.velocity) else vector(
+        f"{w}.velocity", (0.0,) * dim if b.velocity is None else b.velocity, dim)
     return Block(b.material, blo, bhi, vel, ppc, b.name or f"block{i}")

@@ -1,203 +1,347 @@
-"""Single-material-point driver for the Cam-Clay snow model (no grid).
+"""Material-point driver: the engine's constitutive update on independent points (no grid).
 
-Drives the elastic deformation gradient ``F_E`` of independent material points
-through prescribed incremental deformation gradients, exactly as the MPM
-engine does per particle and step: ``F_tr = F_inc F_E``, SVD, Cam-Clay return
-mapping (:func:`mpm_warp.kernels.camclay.camclay_return_func`), rebuild of
-``F_E``. Used to test the constitutive update (VALIDATION.md, "Cam-Clay single
-material point") and to calibrate ``M``, ``beta``, ``xi`` and ``p0``.
+Each point carries the engine's particle state (``H = F_E - I``, ``h_zz`` in plane
+strain, ``log_Jp``) and goes through prescribed increments of the velocity
+gradient ``L = dt grad v`` (equivalently ``F_inc = I + L``): the trial is
+``H_tr = H + L + L H`` and the update is
+:func:`mpm_warp.kernels.constitutive.constitutive_update_func`, the very
+function P2G calls, so a point driven by the ``dt C`` a particle saw follows that
+particle bit for bit. Used to test the constitutive update (VALIDATION.md,
+"Cam-Clay single material point") and to calibrate a material before a big run.
 
-Stresses are Kirchhoff, in Pa, compression positive (MODEL.md section 1).
+Mixed control: on chosen axes the normal Cauchy stress is prescribed instead of
+the strain (oedometer with a constant load, triaxial with a confining stress,
+simple shear under a constant normal stress). The diagonal entries of ``L`` on
+those axes are then unknowns, solved at every increment by Newton iterations
+with the elastic tangent (``d sigma_aa / d L_bb = lam + 2 mu delta_ab``), repeating
+the update from the increment's start state.
+
+Stresses: ``p``, ``q`` Kirchhoff, compression positive (MODEL.md 1); ``stress``
+Cauchy ``tau / J_E``, tension positive.
 """
+
 
 import functools
 
 import numpy as np
 import warp as wp
 
-from mpm_warp.errors import InvalidArgument
-from mpm_warp.kernels.camclay import (
-    SINGULAR_VALUE_FLOOR,
-    camclay_p0_func,
-    camclay_pq_func,
-    camclay_return_func,
-    initial_log_jp,
-)
-from mpm_warp.kernels.elasticity import clamp_singular_func
-from mpm_warp.kernels.types import mat33
+from .errors import InvalidArgument
+from .kernels.camclay import SINGULAR_VALUE_FLOOR, camclay_p0_func
+from .kernels.constitutive import constitutive_update_func, material_struct, principal_strain_func, trial_func
+from .kernels.elasticity import hencky_strain_func
+from .kernels.types import mat, vec
+from .materials import CamClaySnow, Elastic, lame_parameters
+from .model import material_params
 
 __all__ = ["drive_material_points", "isotropic_compression", "lame_parameters", "strain_path"]
 
 _DTYPES = {"float32": (wp.float32, np.float32), "float64": (wp.float64, np.float64)}
-
-
-def lame_parameters(E: float, nu: float) -> tuple[float, float, float]:
-    """Return ``(mu, lam, K)`` (Pa) from Young's modulus ``E`` (Pa) and Poisson's ratio ``nu``.
-
-    ``mu = E / (2 (1 + nu))``, ``lam = E nu / ((1 + nu)(1 - 2 nu))``,
-    ``K = lam + 2 mu / 3`` (MODEL.md section 1).
-    """
-    mu = E / (2.0 * (1.0 + nu))
-    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    return mu, lam, lam + 2.0 * mu / 3.0
+_MAX_CONTROL_ITERATIONS = 60
 
 
 @functools.cache
-def _drive_kernel(T):
-    """Kernel: one thread per material point, looping over its increments."""
-    m33 = mat33(T)
-    camclay_return = camclay_return_func(T)
-    camclay_pq = camclay_pq_func(T)
-    camclay_p0 = camclay_p0_func(T)
-    clamp_singular = clamp_singular_func(T)
-    s_floor = SINGULAR_VALUE_FLOOR
+def _drive_kernel(dim, T, model):
+    """One thread per material point, looping over its increments."""
+    M = mat(dim, T)
+    M3 = mat(3, T)
+    V3 = vec(3, T)
+    Vd = vec(dim, T)
+    P = material_struct(T)
+    update = constitutive_update_func(dim, T, model)
+    trial = trial_func(T, dim)
+    D = wp.float64
+    MD = mat(dim, D)
+    principal64 = principal_strain_func(D, dim)
+    hencky64 = hencky_strain_func(D)
+    p0f = camclay_p0_func(T)
+    plastic = model != "elastic"
+    max_it = _MAX_CONTROL_ITERATIONS
 
-    @wp.kernel(enable_backward=False)
-    def drive(
-        F_inc: wp.array2d(dtype=m33),
-        log_jp_ini: T,
-        mu: T,
-        lam: T,
-        M: T,
-        beta: T,
-        xi: T,
-        p0_floor: T,
-        F_E: wp.array2d(dtype=m33),
-        p: wp.array2d(dtype=T),
-        q: wp.array2d(dtype=T),
-        log_jp: wp.array2d(dtype=T),
-        p0: wp.array2d(dtype=T),
-        yielded: wp.array2d(dtype=wp.int32),
-    ):
+    @wp.func
+    def step(H: M, hzz: T, lj: T, L: M, m: P):
+        H_tr = trial(H, L)
+        hzz_tr = hzz
+        if wp.static(dim == 2):
+            H_new, hzz_new, tau, lj_new, flags = update(H_tr, hzz, lj, m)
+            return H_tr, hzz_tr, H_new, hzz_new, lj_new, flags
+        else:
+            H_new, tau, lj_new, flags = update(H_tr, lj, m)
+            return H_tr, hzz_tr, H_new, hzz, lj_new, flags
+
+    @wp.func
+    def cauchy(H: M, hzz: T, m: P):
+        """Cauchy stress, principal stretches and Kirchhoff stresses of a state, evaluated in float64 (outputs
+        and stress control measure the stored state, not a float32 re-rounding of ``I + H``)."""
+        U, eps, Vm, s, svd = principal64(MD(H), D(hzz), D(m.s_floor))
+        tau = hencky64(eps, D(m.mu), D(m.lam))
+        J = wp.exp(eps[0] + eps[1] + eps[2])
+        sig = M3()
+        for a in range(dim):
+            for b in range(dim):
+                acc = D(0.0)
+                for k in range(dim):
+                    acc += U[a, k] * tau[k] * U[b, k]
+                sig[a, b] = T(acc / J)
+        if wp.static(dim == 2):
+            sig[2, 2] = T(tau[2] / J)
+        return sig, V3(eps), V3(tau)
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def drive(L_path: wp.array2d(dtype=M), params: wp.array(dtype=P), H0: wp.array(dtype=M), hzz0: wp.array(dtype=T),
+              lj0: wp.array(dtype=T), control: wp.array2d(dtype=T), stress_tol: wp.array(dtype=T),
+              H_out: wp.array2d(dtype=M), hzz_out: wp.array2d(dtype=T), lj_out: wp.array2d(dtype=T),
+              yielded: wp.array2d(dtype=wp.int32), eps_trial: wp.array2d(dtype=V3), eps: wp.array2d(dtype=V3),
+              sigma: wp.array2d(dtype=M3), p_out: wp.array2d(dtype=T), q_out: wp.array2d(dtype=T),
+              p0_out: wp.array2d(dtype=T), L_used: wp.array2d(dtype=M), residual: wp.array2d(dtype=T)):
         i = wp.tid()
-        K = lam + T(2.0) / T(3.0) * mu
-        sf = T(s_floor)
-        Fe = wp.identity(n=3, dtype=T)
-        ljp = log_jp_ini
-        F_E[i, 0] = Fe
-        log_jp[i, 0] = ljp
-        p0[i, 0] = camclay_p0(ljp, K, xi, p0_floor)
-        for k in range(F_inc.shape[1]):
-            F_tr = F_inc[i, k] * Fe
-            U, sig, V = wp.svd3(F_tr)
-            sig_new, ljp_new, y = camclay_return(sig, ljp, mu, lam, M, beta, xi, p0_floor)
-            ljp = ljp_new
-            if y != 0 or sig[2] < sf:
-                Fe = U * wp.diag(clamp_singular(sig_new, sf)) * wp.transpose(V)
-            else:
-                Fe = F_tr
-            pk, qk = camclay_pq(sig_new, mu, lam)
-            F_E[i, k + 1] = Fe
-            p[i, k + 1] = pk
-            q[i, k + 1] = qk
-            log_jp[i, k + 1] = ljp
-            p0[i, k + 1] = camclay_p0(ljp, K, xi, p0_floor)
-            yielded[i, k + 1] = y
+        m = params[i]
+        K = m.lam + (T(2.0) / T(3.0)) * m.mu
+        H = H0[i]
+        hzz = hzz0[i]
+        lj = lj0[i]
+        H_out[i, 0] = H
+        hzz_out[i, 0] = hzz
+        lj_out[i, 0] = lj
+        sig, e0, tau = cauchy(H, hzz, m)
+        sigma[i, 0] = sig
+        eps[i, 0] = e0
+        eps_trial[i, 0] = e0
+        p = -(tau[0] + tau[1] + tau[2]) / T(3.0)
+        p_out[i, 0] = p
+        dv = tau + V3(p, p, p)
+        q_out[i, 0] = wp.sqrt(T(1.5) * wp.dot(dv, dv))
+        if wp.static(plastic):
+            p0_out[i, 0] = p0f(lj, K, m.xi, m.p0_floor)
+        # control[i] = (mask_0..mask_{dim-1}, target_0..target_{dim-1}); elastic tangent on the controlled axes
+        n_ctl = int(0)
+        Jac = M()
+        for a in range(dim):
+            if control[i, a] != T(0.0):
+                n_ctl += 1
+            for b in range(dim):
+                if control[i, a] != T(0.0) and control[i, b] != T(0.0):
+                    Jac[a, b] = m.lam
+                    if a == b:
+                        Jac[a, b] = m.lam + T(2.0) * m.mu
+                elif a == b:
+                    Jac[a, b] = T(1.0)
+        Jinv = wp.inverse(Jac)
+        for k in range(L_path.shape[1]):
+            L = L_path[i, k]
+            H_tr, hzz_tr, H_new, hzz_new, lj_new, flags = step(H, hzz, lj, L, m)
+            res = T(0.0)
+            if n_ctl > 0:
+                it = int(0)
+                while it < max_it:
+                    sig, e_it, tau = cauchy(H_new, hzz_new, m)
+                    r = Vd()
+                    res = T(0.0)
+                    for a in range(dim):
+                        if control[i, a] != T(0.0):
+                            r[a] = sig[a, a] - control[i, dim + a]
+                            res = wp.max(res, wp.abs(r[a]))
+                    if res <= stress_tol[0]:
+                        break
+                    dl = Jinv * r
+                    for a in range(dim):
+                        if control[i, a] != T(0.0):
+                            L[a, a] = L[a, a] - dl[a]
+                    H_tr, hzz_tr, H_new, hzz_new, lj_new, flags = step(H, hzz, lj, L, m)
+                    it += 1
+            residual[i, k + 1] = res
+            L_used[i, k] = L
+            sig_t, e_t, tau_t = cauchy(H_tr, hzz_tr, m)
+            eps_trial[i, k + 1] = e_t
+            H = H_new
+            hzz = hzz_new
+            lj = lj_new
+            H_out[i, k + 1] = H
+            hzz_out[i, k + 1] = hzz
+            lj_out[i, k + 1] = lj
+            yielded[i, k + 1] = flags & 1
+            sig, e_k, tau = cauchy(H, hzz, m)
+            sigma[i, k + 1] = sig
+            eps[i, k + 1] = e_k
+            p = -(tau[0] + tau[1] + tau[2]) / T(3.0)
+            p_out[i, k + 1] = p
+            dv = tau + V3(p, p, p)
+            q_out[i, k + 1] = wp.sqrt(T(1.5) * wp.dot(dv, dv))
+            if wp.static(plastic):
+                p0_out[i, k + 1] = p0f(lj, K, m.xi, m.p0_floor)
 
     return drive
 
 
-def _check_positive(name, value, allow_zero=False):
-    ok = np.isfinite(value) and (value >= 0.0 if allow_zero else value > 0.0)
-    if not ok:
-        raise InvalidArgument(name, value, "a finite number " + (">= 0" if allow_zero else "> 0"))
+def _materials(material, n_points: int, legacy: dict) -> list[Elastic]:
+    """One validated material per point, from ``material`` (one or a list) or the legacy scalar keywords."""
+    if material is None:
+        missing = [k for k in ("E", "nu", "M", "beta", "xi") if legacy.get(k) is None]
+        if missing:
+            raise InvalidArgument("material", None, "a material (Elastic, CamClaySnow) or the keywords E, nu, M, "
+                                                    f"beta, xi (missing: {', '.join(missing)})")
+        E, nu = legacy["E"], legacy["nu"]
+        p0_floor = legacy.get("p0_floor")
+        if p0_floor is not None:
+            K = lame_parameters(E, nu)[2] if np.isfinite(E) and np.isfinite(nu) and nu < 0.5 else 1.0
+            floor_ratio = p0_floor / K if np.isfinite(p0_floor) and p0_floor > 0 and K > 0 else p0_floor
+        else:
+            floor_ratio = 1e-5
+        try:
+            material = CamClaySnow(E=E, nu=nu, density=1.0, M=legacy["M"], beta=legacy["beta"], xi=legacy["xi"],
+                                   p0_ini=legacy.get("p0_ini", 0.0), p0_floor_ratio=floor_ratio)
+            material.validate("material")
+        except InvalidArgument as e:
+            raise InvalidArgument(e.field.split(".")[-1].replace("p0_floor_ratio", "p0_floor"), e.value,
+                                  e.allowed) from None
+    mats = list(material) if isinstance(material, (list, tuple)) else [material] * n_points
+    if len(mats) != n_points:
+        raise InvalidArgument("material", f"{len(mats)} materials", f"one material, or one per point ({n_points})")
+    out = []
+    for k, mt in enumerate(mats):
+        if not isinstance(mt, Elastic):
+            raise InvalidArgument(f"material[{k}]", mt, "an Elastic or CamClaySnow material")
+        out.append(mt.validate(f"material[{k}]"))
+    models = {mt.model for mt in out}
+    if len(models) > 1:
+        raise InvalidArgument("material", sorted(models), "materials of one model in one call")
+    return out
 
 
-def drive_material_points(F_path, *, E, nu, M, beta, xi, p0_ini=0.0, p0_floor=None, dtype="float32",
-                          device=None) -> dict:
-    """Run the Cam-Clay update of independent material points along prescribed paths.
-
-    Each point starts at ``F_E = I``, ``log_Jp = -asinh(p0_ini/K)/xi``
-    (MODEL.md section 3); at increment ``k`` the trial ``F_tr = F_inc[k] F_E``
-    is returned to the yield surface (MODEL.md section 4, SI Note 1) and
-    ``F_E`` rebuilt as ``U diag(sig_new) V^T`` when it yielded or was inverted.
-    One kernel launch runs all points and increments.
+def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None, log_jp0=None,
+                          stress_control=None, stress_tol=None, dtype="float32", device=None,
+                          E=None, nu=None, M=None, beta=None, xi=None, p0_ini=0.0, p0_floor=None) -> dict:
+    """Run the engine's constitutive update on independent material points along prescribed paths.
 
     Parameters
     ----------
-    F_path : array_like, shape (n_points, n_increments, 3, 3) or (n_increments, 3, 3)
-        Incremental deformation gradients ``F_inc`` (dimensionless), finite.
-    E : float
-        Young's modulus (Pa, > 0).
-    nu : float
-        Poisson's ratio, in [0, 0.5).
-    M : float
-        Slope of the critical state line (> 0).
-    beta : float
-        Cohesion ratio (>= 0): tensile strength ``beta p0``.
-    xi : float
-        Hardening coefficient (> 0).
-    p0_ini : float
-        Initial consolidation pressure (Pa, >= 0).
-    p0_floor : float or None
-        Floor on ``p0`` (Pa, > 0). Default ``1e-5 K``: small enough that a fully
-        softened point carries no meaningful stress, large enough to keep the
-        return well conditioned.
+    F_path : array_like, shape (n_points, n_increments, d, d) or (n_increments, d, d)
+        Incremental deformation gradients ``F_inc = I + L`` (-); ``d = 3``, or ``d = 2``
+        for plane strain (the total ``F_zz`` stays 1). ``L = F_inc - I`` is formed in
+        float64 before rounding.
+    L_path : array_like, same shapes
+        The increments ``L = dt grad v`` (-) directly, instead of ``F_path``: a particle's
+        ``dt C`` gives the engine's update bit for bit.
+    material : Elastic, CamClaySnow, or a list of them (one per point, one model)
+        The material; or give the Cam-Clay parameters as keywords ``E, nu, M, beta, xi,
+        p0_ini, p0_floor`` (Pa, -, -, -, -, Pa, Pa).
+    F_E0 : array_like, shape (3, 3) or (n_points, 3, 3), optional
+        Initial elastic deformation gradient (-), default ``I``. In plane strain the
+        in-plane block and ``F_zz`` are used.
+    log_jp0 : float or array_like (n_points,), optional
+        Initial ``ln det F_P`` (-); default from each material's ``p0_ini``.
+    stress_control : dict, optional
+        ``{"axes": (bool,) * d, "sigma": (float,) * d}`` (one for all points, or arrays of
+        shape (n_points, d)): on the axes marked True the normal Cauchy stress (Pa,
+        tension positive) is held at ``sigma`` and the matching diagonal entries of ``L``
+        are solved for at every increment (their given values are the first guess).
+    stress_tol : float, optional
+        Tolerance on the controlled stresses (Pa); default ``1e-7 (lam + 2 mu)`` in float64,
+        ``2e-6 (lam + 2 mu)`` in float32 (a few rounding units of strain).
     dtype : {"float32", "float64"}
-        Scalar type of the kernel.
-    device : str or warp.context.Device or None
+    device : str or None
         Warp device; None means Warp's default device.
 
     Returns
     -------
-    dict of numpy.ndarray
-        Over the path, index 0 the initial state, shape ``(n_points, n_increments + 1)``
-        unless stated: ``p``, ``q`` (Pa), ``log_jp`` (ln det F_P), ``p0`` (Pa),
-        ``yielded`` (int32, 1 where the increment was plastic), ``F_E``
-        (``(n_points, n_increments + 1, 3, 3)``). A single path gives ``n_points = 1``.
+    dict of numpy.ndarray, index 0 the initial state, shape ``(n_points, n_increments + 1, ...)``
+        ``F_E`` (..., 3, 3); ``log_jp``; ``p``, ``q`` (Pa, Kirchhoff, compression positive);
+        ``p0`` (Pa; Cam-Clay); ``stress`` (..., 3, 3) Cauchy (Pa); ``eps_trial``, ``eps``
+        (..., 3): principal Hencky strains of the trial and of the new state (descending
+        in-plane, then zz in 2D); ``yielded`` (int32); ``L`` (n_points, n_increments, d, d)
+        the increments used (solved entries included); ``control_residual`` (Pa, the
+        largest controlled-stress error left at each increment).
 
     Raises
     ------
     InvalidArgument
-        On a non-positive ``E``, ``M`` or ``xi``, ``nu`` outside [0, 0.5),
-        ``beta < 0``, ``p0_ini < 0``, ``p0_floor <= 0``, an unknown ``dtype`` or a
-        badly shaped or non-finite ``F_path``.
+        On bad material parameters, shapes, non-finite paths, an unknown ``dtype``.
     """
-    _check_positive("E", E)
-    if not (np.isfinite(nu) and 0.0 <= nu < 0.5):
-        raise InvalidArgument("nu", nu, "a number in [0, 0.5)")
-    _check_positive("M", M)
-    _check_positive("beta", beta, allow_zero=True)
-    _check_positive("xi", xi)
-    _check_positive("p0_ini", p0_ini, allow_zero=True)
     if dtype not in _DTYPES:
         raise InvalidArgument("dtype", dtype, f"one of {sorted(_DTYPES)}")
     T, np_t = _DTYPES[dtype]
-    mu, lam, K = lame_parameters(E, nu)
-    if p0_floor is None:
-        p0_floor = 1.0e-5 * K
-    _check_positive("p0_floor", p0_floor)
+    if (F_path is None) == (L_path is None):
+        raise InvalidArgument("F_path/L_path", "both" if F_path is not None else "neither", "exactly one of them")
+    name = "F_path" if F_path is not None else "L_path"
+    given = F_path if F_path is not None else L_path
+    A = np.asarray(given, dtype=np.float64)
+    if A.ndim == 3:
+        A = A[None]
+    if A.ndim != 4 or A.shape[2] != A.shape[3] or A.shape[2] not in (2, 3) or A.shape[0] < 1 or A.shape[1] < 1:
+        raise InvalidArgument(name, f"array of shape {np.shape(given)}",
+                              "shape (n_points, n_increments, d, d) or (n_increments, d, d), d = 2 or 3, non-empty")
+    if not np.all(np.isfinite(A)):
+        raise InvalidArgument(name, "array with non-finite entries", "finite entries")
+    n_pts, n_inc, dim = A.shape[0], A.shape[1], A.shape[2]
+    L = A - np.eye(dim) if F_path is not None else A
+    mats = _materials(material, n_pts, dict(E=E, nu=nu, M=M, beta=beta, xi=xi, p0_ini=p0_ini, p0_floor=p0_floor))
+    model = mats[0].model
 
-    F = np.asarray(F_path, dtype=np.float64)
-    if F.ndim == 3:
-        F = F[None]
-    if F.ndim != 4 or F.shape[2:] != (3, 3) or F.shape[0] < 1 or F.shape[1] < 1:
-        raise InvalidArgument("F_path", f"array of shape {np.shape(F_path)}",
-                              "shape (n_points, n_increments, 3, 3) or (n_increments, 3, 3), non-empty")
-    if not np.all(np.isfinite(F)):
-        raise InvalidArgument("F_path", "array with non-finite entries", "finite entries")
+    F0 = np.eye(3) if F_E0 is None else np.asarray(F_E0, dtype=np.float64)
+    F0 = np.broadcast_to(F0, (n_pts, 3, 3)) if F0.shape == (3, 3) else F0
+    if F0.shape != (n_pts, 3, 3) or not np.all(np.isfinite(F0)):
+        raise InvalidArgument("F_E0", f"array of shape {F0.shape}", f"finite, shape (3, 3) or ({n_pts}, 3, 3)")
+    H0 = F0[:, :dim, :dim] - np.eye(dim)
+    hzz0 = F0[:, 2, 2] - 1.0 if dim == 2 else np.zeros(n_pts)
+    if log_jp0 is None:
+        lj0 = np.array([getattr(mt, "initial_log_jp", 0.0) for mt in mats])
+    else:
+        lj0 = np.broadcast_to(np.asarray(log_jp0, dtype=np.float64), (n_pts,)).copy()
+        if not np.all(np.isfinite(lj0)):
+            raise InvalidArgument("log_jp0", log_jp0, "finite values")
+
+    control = np.zeros((n_pts, 2 * dim))
+    if stress_control is not None:
+        try:
+            axes = np.broadcast_to(np.asarray(stress_control["axes"], dtype=bool), (n_pts, dim))
+            target = np.broadcast_to(np.asarray(stress_control["sigma"], dtype=np.float64), (n_pts, dim))
+        except (KeyError, TypeError, ValueError) as e:
+            expected = f"{{'axes': {dim} booleans, 'sigma': {dim} stresses (Pa)}} per point or shared"
+            raise InvalidArgument("stress_control", stress_control, expected) from e
+        if not np.all(np.isfinite(target)):
+            raise InvalidArgument("stress_control.sigma", stress_control["sigma"], "finite stresses (Pa)")
+        control[:, :dim] = axes
+        control[:, dim:] = np.where(axes, target, 0.0)
+    stiff = max(mt.lam + 2.0 * mt.mu for mt in mats)
+    if stress_tol is None:
+        stress_tol = (2e-6 if dtype == "float32" else 1e-7) * stiff
+    if not (np.isfinite(stress_tol) and stress_tol > 0):
+        raise InvalidArgument("stress_tol", stress_tol, "a finite number > 0 (Pa)")
 
     device = wp.get_device(device)
-    n_pts, n_inc = F.shape[:2]
-    m33 = mat33(T)
-    F_inc = wp.array(F.astype(np_t), dtype=m33, device=device)
+    Md, M3, V3 = mat(dim, T), mat(3, T), vec(3, T)
     shape = (n_pts, n_inc + 1)
     out = {
-        "F_E": wp.zeros(shape, dtype=m33, device=device),
-        "p": wp.zeros(shape, dtype=T, device=device),
-        "q": wp.zeros(shape, dtype=T, device=device),
-        "log_jp": wp.zeros(shape, dtype=T, device=device),
-        "p0": wp.zeros(shape, dtype=T, device=device),
-        "yielded": wp.zeros(shape, dtype=wp.int32, device=device),
+        "H": wp.zeros(shape, dtype=Md, device=device), "hzz": wp.zeros(shape, dtype=T, device=device),
+        "log_jp": wp.zeros(shape, dtype=T, device=device), "yielded": wp.zeros(shape, dtype=wp.int32, device=device),
+        "eps_trial": wp.zeros(shape, dtype=V3, device=device), "eps": wp.zeros(shape, dtype=V3, device=device),
+        "stress": wp.zeros(shape, dtype=M3, device=device), "p": wp.zeros(shape, dtype=T, device=device),
+        "q": wp.zeros(shape, dtype=T, device=device), "p0": wp.zeros(shape, dtype=T, device=device),
+        "L": wp.zeros((n_pts, n_inc), dtype=Md, device=device),
+        "control_residual": wp.zeros(shape, dtype=T, device=device),
     }
-    wp.launch(
-        _drive_kernel(T),
-        dim=n_pts,
-        inputs=[F_inc, T(initial_log_jp(p0_ini, K, xi)), T(mu), T(lam), T(M), T(beta), T(xi), T(p0_floor)],
-        outputs=[out[k] for k in ("F_E", "p", "q", "log_jp", "p0", "yielded")],
-        device=device,
-    )
-    return {k: a.numpy() for k, a in out.items()}
+    params = wp.array([material_params(mt, T) for mt in mats], dtype=material_struct(T), device=device)
+    wp.launch(_drive_kernel(dim, T, model), dim=n_pts,
+              inputs=[wp.array(L.astype(np_t), dtype=Md, device=device), params,
+                      wp.array(H0.astype(np_t), dtype=Md, device=device),
+                      wp.array(hzz0.astype(np_t), dtype=T, device=device),
+                      wp.array(lj0.astype(np_t), dtype=T, device=device),
+                      wp.array(control.astype(np_t), dtype=T, device=device),
+                      wp.array([stress_tol], dtype=T, device=device)],
+              outputs=[out[k] for k in ("H", "hzz", "log_jp", "yielded", "eps_trial", "eps", "stress", "p", "q",
+                                        "p0", "L", "control_residual")],
+              device=device)
+    res = {k: a.numpy() for k, a in out.items()}
+    H, hzz = res.pop("H").astype(np.float64), res.pop("hzz").astype(np.float64)
+    F = np.zeros((n_pts, n_inc + 1, 3, 3))
+    F[..., :dim, :dim] = H
+    F[..., range(3), range(3)] += 1.0
+    if dim == 2:
+        F[..., 2, 2] += hzz
+    res["F_E"] = F
+    if model == "elastic":
+        res.pop("p0")
+    return res
 
 
 def strain_path(H, n_increments: int) -> np.ndarray:
@@ -207,21 +351,21 @@ def strain_path(H, n_increments: int) -> np.ndarray:
 
     Parameters
     ----------
-    H : array_like, shape (3, 3) or (n_points, 3, 3)
+    H : array_like, shape (d, d) or (n_points, d, d), d = 2 or 3
         Total displacement-gradient-like increment ``grad v * t_total`` (dimensionless).
     n_increments : int
         Number of increments (>= 1).
 
     Returns
     -------
-    numpy.ndarray, shape (n_increments, 3, 3) or (n_points, n_increments, 3, 3)
+    numpy.ndarray, shape (n_increments, d, d) or (n_points, n_increments, d, d)
     """
     if int(n_increments) < 1:
         raise InvalidArgument("n_increments", n_increments, "an integer >= 1")
     H = np.asarray(H, dtype=np.float64)
-    if H.shape[-2:] != (3, 3) or H.ndim not in (2, 3):
-        raise InvalidArgument("H", f"array of shape {H.shape}", "shape (3, 3) or (n_points, 3, 3)")
-    step = np.eye(3) + H / int(n_increments)
+    if H.ndim not in (2, 3) or H.shape[-1] != H.shape[-2] or H.shape[-1] not in (2, 3):
+        raise InvalidArgument("H", f"array of shape {H.shape}", "shape (d, d) or (n_points, d, d), d = 2 or 3")
+    step = np.eye(H.shape[-1]) + H / int(n_increments)
     return np.repeat(step[..., None, :, :], int(n_increments), axis=-3)
 
 
@@ -240,8 +384,8 @@ def isotropic_compression(volumetric_strain: float, n_increments: int, **materia
     n_increments : int
         Number of increments (>= 1).
     **material
-        Keyword arguments of :func:`drive_material_points` (``E``, ``nu``, ``M``,
-        ``beta``, ``xi``, ``p0_ini``, ``p0_floor``, ``dtype``, ``device``).
+        Keyword arguments of :func:`drive_material_points` (``material`` or ``E``, ``nu``,
+        ``M``, ``beta``, ``xi``, ``p0_ini``, ``p0_floor``; ``dtype``, ``device``).
 
     Returns
     -------
@@ -255,3 +399,7 @@ def isotropic_compression(volumetric_strain: float, n_increments: int, **materia
     n = int(n_increments)
     step = np.exp(-volumetric_strain / (3.0 * n)) * np.eye(3)
     return drive_material_points(np.repeat(step[None], n, axis=0), **material)
+
+
+#: floor on singular values used by the update (re-exported for calibration scripts)
+SINGULAR_VALUE_FLOOR = SINGULAR_VALUE_FLOOR

@@ -14,7 +14,7 @@ import numpy as np
 from .checks import finite_number
 from .kernels.camclay import initial_log_jp
 
-__all__ = ["Elastic", "CamClaySnow", "Material", "material_from_dict", "MATERIAL_MODELS", "lame_parameters",
+__all__ = ["Elastic", "CamClaySnow", "Material", "MATERIAL_MODELS", "lame_parameters",
            "hardening_collapse"]
 
 
@@ -164,26 +164,3 @@ class CamClaySnow(Elastic):
 
 Material = Elastic | CamClaySnow
 MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow}
-
-
-def material_from_dict(d: dict, where: str = "material") -> Elastic:
-    """Build a material from a dict with a ``model`` key; unknown keys are errors."""
-    import difflib
-
-    from .errors import ScenarioError
-
-    d = dict(d)
-    model = d.pop("model", "elastic")
-    if not isinstance(model, str) or model not in MATERIAL_MODELS:
-        raise ScenarioError(f"{where}.model = {model!r} is unknown: expected one of {sorted(MATERIAL_MODELS)}")
-    cls = MATERIAL_MODELS[model]
-    names = [f for f in cls.__dataclass_fields__ if f != "model"]
-    for k in d:
-        if k not in names:
-            close = difflib.get_close_matches(k, names, n=1)
-            hint = f" (did you mean '{where}.{close[0]}'?)" if close else ""
-            raise ScenarioError(f"unknown key '{where}.{k}'{hint} for model {model!r}; allowed: {', '.join(names)}")
-    for k in ("E", "nu", "density"):
-        if k not in d:
-            raise ScenarioError(f"{where}.{k}: missing (required for model {model!r})")
-    return cls(**d).validate(where)

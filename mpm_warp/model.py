@@ -18,11 +18,13 @@ import warp as wp
 
 from .config import Scenario
 from .kernels.camclay import SINGULAR_VALUE_FLOOR
+from .kernels.constitutive import material_struct
 from .kernels.grid_update import wall_struct
-from .kernels.types import mat33, vec3
+from .kernels.types import mat, vec
 from .materials import CamClaySnow, Elastic
 
-__all__ = ["Model", "State", "ParticleGroup", "seed_block", "velocity_gradient", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
+__all__ = ["Model", "State", "ParticleGroup", "seed_block", "velocity_gradient", "material_params",
+           "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
 
 #: grid nodes added outside the domain box on each side
 GRID_PADDING = 3
@@ -54,31 +56,46 @@ class ParticleGroup:
 def seed_block(lo, hi, dx: float, ppc: int) -> tuple[np.ndarray, float]:
     """Particles on a regular lattice filling ``[lo, hi]`` with ``ppc`` per cell and axis.
 
-    Returns positions (n, 3) in m and the particle volume (m^3). The lattice
-    spacing is ``dx / ppc``; the count per axis is rounded so the block volume is
-    preserved to within half a spacing per face.
+    Returns positions (n, dim) in m (``dim = len(lo)``) and the particle volume
+    (m^3; in 2D m^2 times one metre of depth). The lattice spacing is
+    ``dx / ppc``; the count per axis is rounded so the block volume is preserved
+    to within half a spacing per face. Particles are ordered with the last axis
+    fastest (``np.meshgrid(..., indexing="ij")``).
     """
     h = dx / ppc
+    dim = len(lo)
     axes = []
-    for a in range(3):
+    for a in range(dim):
         n = max(1, int(round((hi[a] - lo[a]) / h)))
         step = (hi[a] - lo[a]) / n
         axes.append(lo[a] + (np.arange(n) + 0.5) * step)
-    vol = float(np.prod([(hi[a] - lo[a]) / len(axes[a]) for a in range(3)]))
-    X, Y, Z = np.meshgrid(*axes, indexing="ij")
-    return np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1), vol
+    vol = float(np.prod([(hi[a] - lo[a]) / len(axes[a]) for a in range(dim)]))
+    grids = np.meshgrid(*axes, indexing="ij")
+    return np.stack([g.ravel() for g in grids], axis=1), vol
+
+
+def material_params(material: Elastic, T):
+    """Kernel-side parameters (``kernels.constitutive.material_struct``) of a material, scalar type ``T``."""
+    m = material_struct(T)()
+    m.mu = T(material.mu)
+    m.lam = T(material.lam)
+    m.s_floor = T(SINGULAR_VALUE_FLOOR)
+    if isinstance(material, CamClaySnow):
+        m.M, m.beta, m.xi, m.p0_floor = T(material.M), T(material.beta), T(material.xi), T(material.p0_floor)
+    return m
 
 
 def velocity_gradient(field, x: np.ndarray, h: float) -> np.ndarray:
-    """Central-difference gradient ``dv_i/dx_j`` (1/s) of a velocity function at points ``x`` (n, 3).
+    """Central-difference gradient ``dv_i/dx_j`` (1/s) of a velocity function at points ``x`` (n, dim).
 
     Used to start APIC/MLS particles with the affine matrix ``C = grad v`` of a
     prescribed initial velocity field, so a rigid spin or shear starts without
     the energy loss of ``C = 0``.
     """
-    grad = np.zeros((len(x), 3, 3))
-    for j in range(3):
-        e = np.zeros(3)
+    dim = x.shape[1]
+    grad = np.zeros((len(x), dim, dim))
+    for j in range(dim):
+        e = np.zeros(dim)
         e[j] = h
         grad[:, :, j] = (np.asarray(field(x + e)) - np.asarray(field(x - e))) / (2.0 * h)
     return grad
@@ -98,8 +115,10 @@ class Model:
     ----------
     T : warp scalar type
         ``wp.float32`` or ``wp.float64``.
-    origin : (3,) float
-        Position of grid node (0, 0, 0) (m).
+    dim : int
+        Spatial dimension (2: plane strain, 3).
+    origin : (dim,) float
+        Position of grid node (0, ..., 0) (m).
     grid_shape : tuple of int
         Nodes per axis.
     groups : list of ParticleGroup
@@ -115,14 +134,15 @@ class Model:
         self.T = wp.float64 if scenario.precision == "float64" else wp.float32
         self.np_dtype = np.float64 if scenario.precision == "float64" else np.float32
         dom = scenario.domain
+        self.dim = dom.dimension
         self.dx = dom.dx
         lo = np.asarray(dom.lo, dtype=np.float64)
         hi = np.asarray(dom.hi, dtype=np.float64)
         self.origin = lo - GRID_PADDING * self.dx
         self.grid_shape = tuple(
-            int(math.ceil((hi[a] - lo[a]) / self.dx - 1e-9)) + 2 * GRID_PADDING + 1 for a in range(3)
+            int(math.ceil((hi[a] - lo[a]) / self.dx - 1e-9)) + 2 * GRID_PADDING + 1 for a in range(self.dim)
         )
-        # particles must keep their 3x3x3 stencil inside the grid: grid coordinate in [1, n - 2]
+        # particles must keep their 3^dim stencil inside the grid: grid coordinate in [1, n - 2]
         self.x_lo = self.origin + 1.0 * self.dx
         self.x_hi = self.origin + (np.asarray(self.grid_shape) - 2.0) * self.dx
 
@@ -132,7 +152,7 @@ class Model:
         if dom.boundary != "none":
             walls += box_walls(lo, hi, dom.boundary, dom.friction, dom.boundary_faces)
         walls += list(scenario.walls)
-        self.walls = [w.validate() for w in walls]
+        self.walls = [w.validate(dim=self.dim) for w in walls]
         self.c_p = max(m.p_wave_speed for m in scenario.materials.values())
         self.gravity = np.asarray(scenario.time.gravity, dtype=np.float64)
 
@@ -160,13 +180,14 @@ class Model:
 
         self.walls_device = None
         if self.walls:
-            W = wall_struct(self.T)
+            W = wall_struct(self.T, self.dim)
+            V = vec(self.dim, self.T)
             items = []
             for w in self.walls:
                 s = W()
-                s.point = vec3(self.T)(*w.point)
-                s.normal = vec3(self.T)(*w.normal)
-                s.velocity = vec3(self.T)(*w.velocity)
+                s.point = V(*w.point)
+                s.normal = V(*w.normal)
+                s.velocity = V(*w.velocity)
                 s.ramp_time = self.T(w.ramp_time)
                 s.kind = w.kind_id
                 s.friction = self.T(w.friction)
@@ -179,10 +200,11 @@ class Model:
         return [w.name for w in self.walls]
 
     def initial_state(self, track_yield: bool = False) -> State:
-        """Allocate and fill the state at t = 0."""
+        """Allocate and fill the state at t = 0 (``F_E = I``, ``log_Jp`` from each material's ``p0_ini``)."""
+        d = self.dim
         x = np.concatenate([s[1] for s in self._seed]).astype(self.np_dtype)
         v = np.zeros_like(x)
-        C = np.zeros((len(x), 3, 3), dtype=self.np_dtype)
+        C = np.zeros((len(x), d, d), dtype=self.np_dtype)
         for g, (b, xb) in zip(self.groups, self._seed, strict=True):
             if callable(b.velocity):
                 v[g.start:g.end] = b.velocity(xb)
@@ -202,59 +224,93 @@ class Model:
 
 
 class State:
-    """Time-varying fields on the device.
+    """Time-varying fields on the device (``dim``-vectors and ``dim x dim`` matrices).
 
     Attributes
     ----------
-    x, v : wp.array of vec3, (N,)
+    x, v : wp.array of vec, (N,)
         Position (m) and velocity (m/s).
-    C : wp.array of mat33, (N,)
+    C : wp.array of mat, (N,)
         APIC/MLS affine velocity matrix (1/s).
-    F : wp.array of mat33, (N,)
-        Elastic deformation gradient F_E (-).
+    H : wp.array of mat, (N,)
+        Elastic displacement gradient ``F_E - I`` (-), in-plane block in 2D (see
+        ``kernels/constitutive.py``: stored as ``F_E - I`` so that float32 keeps
+        increments far below its resolution of 1).
+    hzz : wp.array, (N,) or None
+        Out-of-plane elastic stretch minus one, ``F_E,zz - 1`` (-), plane strain only.
     log_jp : wp.array, (N_plastic,) or None
         ln det F_P of Cam-Clay particles.
     yielded : wp.array of uint8, (N_plastic,) or None
         Return-mapping activity flag, only when the output asks for it.
-    clock : wp.array of float64, (3,)
-        ``[t, dt, t_end]`` (s).
+    clock : wp.array of float64, (4,)
+        ``[t, dt, t_end, dt_last]`` (s).
     steps : wp.array of int64, (1,)
         Steps taken.
     """
 
+    #: the arrays a checkpoint holds (those that exist)
+    CHECKPOINT_FIELDS = ("x", "v", "C", "H", "hzz", "log_jp", "clock", "steps")
+
     def __init__(self, model: Model, x, v, C, log_jp, track_yield: bool):
         dev = model.device
         T = model.T
-        V, M = vec3(T), mat33(T)
+        d = model.dim
+        V, M = vec(d, T), mat(d, T)
         n = len(x)
         self.model = model
         self.x = wp.array(x, dtype=V, device=dev)
         self.v = wp.array(v.astype(model.np_dtype), dtype=V, device=dev)
         self.C = wp.array(C, dtype=M, device=dev)
-        self.F = wp.array(np.tile(np.eye(3, dtype=model.np_dtype), (n, 1, 1)), dtype=M, device=dev)
+        self.H = wp.zeros(n, dtype=M, device=dev)
+        self.hzz = wp.zeros(n, dtype=T, device=dev) if d == 2 else None
         self.log_jp = wp.array(log_jp, dtype=T, device=dev) if model.n_plastic else None
         track = track_yield and model.n_plastic > 0
         self.yielded = wp.zeros(model.n_plastic, dtype=wp.uint8, device=dev) if track else None
-        self.clock = wp.zeros(3, dtype=wp.float64, device=dev)
+        self.clock = wp.zeros(4, dtype=wp.float64, device=dev)
         self.steps = wp.zeros(1, dtype=wp.int64, device=dev)
 
     def particle_bytes(self) -> int:
         """Bytes held by per-particle arrays on the device."""
-        arrs = [self.x, self.v, self.C, self.F, self.log_jp, self.yielded]
+        arrs = [self.x, self.v, self.C, self.H, self.hzz, self.log_jp, self.yielded]
         return sum(a.capacity for a in arrs if a is not None)
+
+    def elastic_deformation_gradient(self) -> np.ndarray:
+        """Host copy of ``F_E`` as (N, 3, 3) float64 (in 2D: the in-plane block and ``F_zz``)."""
+        H = self.H.numpy().astype(np.float64)
+        n, d = H.shape[0], H.shape[1]
+        F = np.zeros((n, 3, 3))
+        F[:, :d, :d] = H
+        F[:, range(3), range(3)] += 1.0
+        if self.hzz is not None:
+            F[:, 2, 2] += self.hzz.numpy().astype(np.float64)
+        return F
+
+    def set_elastic_deformation_gradient(self, F) -> None:
+        """Set ``F_E`` from (N, 3, 3) (in 2D only the in-plane block and ``F_zz`` are used; computed as
+        ``F - I`` in float64 before rounding to the state's precision)."""
+        F = np.asarray(F, dtype=np.float64)
+        d = self.model.dim
+        H = F[:, :d, :d] - np.eye(d)
+        self.H.assign(H.astype(self.model.np_dtype))
+        if self.hzz is not None:
+            self.hzz.assign((F[:, 2, 2] - 1.0).astype(self.model.np_dtype))
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Host copies of the full state (for checkpoints)."""
-        d = {"x": self.x.numpy(), "v": self.v.numpy(), "C": self.C.numpy(), "F": self.F.numpy(),
-             "clock": self.clock.numpy(), "steps": self.steps.numpy()}
-        if self.log_jp is not None:
-            d["log_jp"] = self.log_jp.numpy()
+        d = {}
+        for k in self.CHECKPOINT_FIELDS:
+            a = getattr(self, k)
+            if a is not None:
+                d[k] = a.numpy()
         return d
 
     def load_arrays(self, d: dict[str, np.ndarray]) -> None:
         """Restore the state from :meth:`arrays` output (bit for bit)."""
-        for k in ("x", "v", "C", "F", "clock", "steps", "log_jp"):
+        for k in self.CHECKPOINT_FIELDS:
             dst = getattr(self, k)
             if dst is None:
                 continue
-            dst.assign(np.asarray(d[k]))
+            a = np.asarray(d[k])
+            if k == "clock" and a.shape[0] < dst.shape[0]:  # a 3-entry clock of an older checkpoint
+                a = np.concatenate([a, [a[1]]])
+            dst.assign(a)

@@ -14,7 +14,7 @@ with :meth:`mpm_warp.Simulation.add_monitor`; the engine then, without knowing w
 
 A monitor reads and writes particles only through :meth:`mpm_warp.Simulation.group_state`
 (array views of one particle group, :class:`GroupState`) and the device clock
-(:attr:`mpm_warp.Simulation.clock`, float64 ``[t, dt, t_end]`` in s).
+(:attr:`mpm_warp.Simulation.clock`, float64 ``[t, dt, t_end, dt_last]`` in s).
 """
 
 from __future__ import annotations
@@ -69,10 +69,14 @@ class GroupState:
         Range of the group in the particle arrays (and in output fields).
     mass, vol0 : float
         Mass (kg) and initial volume (m^3) of one particle.
-    x, v : wp.array of vec3
+    x, v : wp.array of dim-vectors
         Positions (m) and velocities (m/s).
-    C, F : wp.array of mat33
-        Affine velocity matrix (1/s) and elastic deformation gradient F_E (-).
+    C : wp.array of dim x dim matrices
+        Affine velocity matrix (1/s).
+    H : wp.array of dim x dim matrices
+        Elastic displacement gradient ``F_E - I`` (-) (in 2D the in-plane block).
+    hzz : wp.array or None
+        ``F_E,zz - 1`` (-) in plane strain (2D), else None.
     log_jp : wp.array or None
         ``ln det F_P`` of a Cam-Clay group (None for elastic groups).
     x0 : ndarray (n, 3), float64
@@ -88,7 +92,8 @@ class GroupState:
     x: wp.array
     v: wp.array
     C: wp.array
-    F: wp.array
+    H: wp.array
+    hzz: wp.array | None
     log_jp: wp.array | None
     x0: np.ndarray
 

@@ -19,8 +19,8 @@ from . import io
 from .config import OUTPUT_FIELDS, Scenario
 from .device import resolve_device
 from .errors import InvalidArgument, OutputError, SimulationBlowUp
-from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_invariants_kernel, stress_kernel
-from .model import SINGULAR_VALUE_FLOOR, Model, ParticleGroup, State
+from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_kernel
+from .model import Model, ParticleGroup, State, material_params
 from .monitor import GroupState, Monitor
 from .result import RunResult, versions
 from .step import Stepper
@@ -79,7 +79,7 @@ class Simulation:
 
     @property
     def clock(self) -> wp.array:
-        """Device clock ``[t, dt, t_end]`` (float64, s), read by device actions."""
+        """Device clock ``[t, dt, t_end, dt_last]`` (float64, s), read by device actions."""
         return self.state.clock
 
     def add_monitor(self, monitor: Monitor) -> Monitor:
@@ -104,56 +104,57 @@ class Simulation:
         g, s = self.group(name), self.state
         sl = slice(g.start, g.end)
         ljp = s.log_jp[g.plastic_start:g.plastic_start + g.count] if g.plastic_start >= 0 else None
-        return GroupState(g.name, g.material, g.start, g.end, g.mass, g.vol0, s.x[sl], s.v[sl], s.C[sl], s.F[sl], ljp,
-                          self.x0[sl])
+        return GroupState(g.name, g.material, g.start, g.end, g.mass, g.vol0, s.x[sl], s.v[sl], s.C[sl], s.H[sl],
+                          s.hzz[sl] if s.hzz is not None else None, ljp, self.x0[sl])
 
     def energies(self) -> dict[str, float]:
-        """Kinetic and elastic energy (J) of the current state."""
+        """Kinetic and elastic energy (J; J/m of depth in 2D) of the current state."""
         self._energy.zero_()
         T = self.model.T
         s = self.state
         for g in self.model.groups:
             sl = slice(g.start, g.end)
-            m = g.material
-            wp.launch(energy_kernel(T), g.count,
-                      inputs=[s.v[sl], s.F[sl], T(g.mass), T(g.vol0), T(m.mu), T(m.lam), T(SINGULAR_VALUE_FLOOR),
+            hz = s.hzz[sl] if s.hzz is not None else None
+            wp.launch(energy_kernel(self.model.dim, T), g.count,
+                      inputs=[s.v[sl], s.H[sl], hz, T(g.mass), T(g.vol0), material_params(g.material, T),
                               self._energy], device=self.device)
         e = self._energy.numpy()
         return {"kinetic_energy": float(e[0]), "elastic_energy": float(e[1])}
 
-    def stress_invariants(self) -> tuple[np.ndarray, np.ndarray]:
-        """Pressure p and Mises stress q (Pa, Kirchhoff) of every particle."""
+    def stresses(self, cauchy: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Pressure p and Mises stress q (Pa, Kirchhoff, compression positive) of every particle and,
+        with ``cauchy``, the Cauchy stress tensor (N, 3, 3) (Pa, tension positive; plane strain: in-plane
+        block and ``sigma_zz``)."""
         T = self.model.T
         n = self.model.n_particles
+        s = self.state
         p = wp.zeros(n, dtype=T, device=self.device)
         q = wp.zeros(n, dtype=T, device=self.device)
+        sig = wp.zeros(n, dtype=wp.types.matrix((3, 3), T), device=self.device) if cauchy else None
         for g in self.model.groups:
             sl = slice(g.start, g.end)
-            m = g.material
-            wp.launch(stress_invariants_kernel(T), g.count,
-                      inputs=[self.state.F[sl], T(m.mu), T(m.lam), T(SINGULAR_VALUE_FLOOR), p[sl], q[sl]],
+            hz = s.hzz[sl] if s.hzz is not None else None
+            wp.launch(stress_kernel(self.model.dim, T), g.count,
+                      inputs=[s.H[sl], hz, material_params(g.material, T), int(cauchy), p[sl], q[sl],
+                              sig[sl] if cauchy else None],
                       device=self.device)
-        return p.numpy(), q.numpy()
+        return p.numpy(), q.numpy(), sig.numpy() if cauchy else None
 
-    def cauchy_stress(self, group: str | None = None) -> np.ndarray:
-        """Cauchy stress tensors (Pa, tension positive), (n, 3, 3), of every particle or of one group."""
-        T = self.model.T
-        groups = self.model.groups if group is None else [self.group(group)]
-        start = groups[0].start if group is not None else 0
-        out = wp.zeros(sum(g.count for g in groups), dtype=self.state.F.dtype, device=self.device)
-        for g in groups:
-            m = g.material
-            wp.launch(stress_kernel(T), g.count, inputs=[self.state.F[g.start:g.end], T(m.mu), T(m.lam),
-                                                         T(SINGULAR_VALUE_FLOOR), out[g.start - start:g.end - start]],
-                      device=self.device)
-        return out.numpy()
+    def stress_invariants(self) -> tuple[np.ndarray, np.ndarray]:
+        """Pressure p and Mises stress q (Pa, Kirchhoff, compression positive) of every particle."""
+        p, q, _ = self.stresses()
+        return p, q
 
     def particle_field(self, name: str) -> np.ndarray:
         """Host copy of one output field for all particles (see ``OUTPUT_FIELDS``)."""
         s = self.state
         n = self.model.n_particles
-        if name in ("x", "v", "F"):
+        if name in ("x", "v"):
             return getattr(s, name).numpy()
+        if name == "F":
+            return s.elastic_deformation_gradient().astype(self.model.np_dtype)
+        if name == "stress":
+            return self.stresses(cauchy=True)[2]
         if name == "log_jp":
             out = np.zeros(n, dtype=self.model.np_dtype)
             if s.log_jp is not None:
@@ -165,8 +166,6 @@ class Simulation:
         if name in ("p", "q"):
             p, q = self.stress_invariants()
             return p if name == "p" else q
-        if name == "stress":
-            return self.cauchy_stress()
         if name == "yielded":
             out = np.zeros(n, dtype=np.uint8)
             if s.yielded is not None:
@@ -183,14 +182,13 @@ class Simulation:
         self._bad.fill_(INT_MAX)
         s = self.state
         T = self.model.T
-        wp.launch(health_kernel(T), self.model.n_particles,
-                  inputs=[s.x, s.v, s.F, s.clock, T(self.model.dx), T(MAX_CELLS_PER_STEP), self._bad],
+        wp.launch(health_kernel(self.model.dim, T), self.model.n_particles,
+                  inputs=[s.x, s.v, s.H, s.hzz, s.clock, T(self.model.dx), T(MAX_CELLS_PER_STEP), self._bad],
                   device=self.device)
         bad = self._bad.numpy()
         causes = [("x/v/F", "non-finite value (NaN or Inf)"),
                   ("v", f"moved more than {MAX_CELLS_PER_STEP:g} cell in one step (|v| dt > dx): "
-                        "time step too large for this speed; lower time.cfl or time.dt"),
-                  ("F", "det F_E <= 0 (inverted element)")]
+                        "time step too large for this speed; lower time.cfl or time.dt")]
         for k, (fld, cause) in enumerate(causes):
             if bad[k] != INT_MAX:
                 t, dt, steps = self.stepper.clock()
@@ -318,6 +316,7 @@ class Simulation:
         pf = {}
         for name in self.scenario.output.fields:
             shape, unit, _ = OUTPUT_FIELDS[name]
+            shape = tuple(self.model.dim if c == "dim" else c for c in shape)
             dt = "uint8" if name == "yielded" else self.scenario.precision
             pf[name] = (shape, dt, unit)
         for m in self.monitors.values():
@@ -355,6 +354,8 @@ class Simulation:
         span = t - getattr(self, "_last_frame_time", t)
         self._last_frame_time = t
         forces = (imp / span if span > 0 else np.zeros_like(imp)) if len(imp) else None
+        if forces is not None and forces.shape[1] < 3:  # plane strain: N per metre of depth, z component 0
+            forces = np.pad(forces, ((0, 0), (0, 3 - forces.shape[1])))
         writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
 
     def _frame_diagnostics(self) -> dict:
@@ -370,9 +371,8 @@ class Simulation:
         meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device,
                 "monitors": sorted(self.monitors)}
         arrays = self.state.arrays()
-        # the next step's speed bound, as one number (the step takes the max over the per-thread slots):
-        # a resume on another thread count or device takes the same step
-        arrays["vmax"] = np.asarray(self.stepper.vmax.numpy().max())
+        # the next step's speed bound, so resume is bit for bit; one number, so any thread count or device resumes
+        arrays["vmax"] = np.asarray([self.stepper.vmax.numpy().max()])
         for name, m in self.monitors.items():
             arrays.update({f"monitors/{name}/{k}": np.asarray(a) for k, a in m.state().items()})
         io.write_checkpoint(path, arrays, meta)

@@ -19,8 +19,8 @@ from .kernels.g2p import g2p_kernel
 from .kernels.grid_update import grid_update_kernel
 from .kernels.p2g import p2g_kernel
 from .kernels.timestep import begin_step_kernel, end_step_kernel
-from .kernels.types import vec3
-from .model import SINGULAR_VALUE_FLOOR, Model, State
+from .kernels.types import vec
+from .model import Model, State, material_params
 
 __all__ = ["Stepper", "default_threads"]
 
@@ -65,7 +65,9 @@ class Stepper:
         self.state = state
         T = model.T
         dev = model.device
-        V = vec3(T)
+        dim = model.dim
+        V = vec(dim, T)
+        Vi = wp.types.vector(dim, wp.int32)
         nt = n_threads or default_threads(dev, model.n_particles)
         nt = max(1, min(nt, model.grid_shape[0] // 3, max(1, model.n_particles // 1000)))
         self.n_threads = nt
@@ -78,17 +80,19 @@ class Stepper:
         self.dt = wp.zeros(1, dtype=T, device=dev)
         self.vmax = wp.zeros(nt, dtype=T, device=dev)
         self.seed_vmax()
-        # per thread: [particles clamped at the grid edge, particles skipped with a stencil outside the grid]
-        self.edge_counts = wp.zeros((nt, 2), dtype=wp.int32, device=dev)
+        # per thread: [particles clamped at the grid edge, particles skipped with a stencil outside the grid,
+        #              singular-value floor events, inversions det F_tr <= 0]
+        self.counts = wp.zeros((nt, 4), dtype=wp.int32, device=dev)
         has_walls = bool(model.walls)
         nw = max(len(model.walls), 1)
-        self.wall_impulses = wp.zeros((nt, nw), dtype=V, device=dev) if has_walls else None
+        self.wall_impulses = wp.zeros((nt, nw), dtype=vec(dim, wp.float64), device=dev) if has_walls else None
         self.fixed_dt = model.scenario.time.dt
         tc = model.scenario.time
         dt_max = tc.dt_max if tc.dt_max > 0 else 1e30
         origin = V(*model.origin)
         inv_dx = T(1.0 / model.dx)
         dx = T(model.dx)
+        shape = Vi(*model.grid_shape)
         s = state
 
         self._begin = wp.launch(begin_step_kernel(T), 1, inputs=[s.clock, self.vmax, tc.cfl, model.dx, model.c_p,
@@ -99,11 +103,8 @@ class Stepper:
         for g in model.groups:
             mat = g.material
             plastic = mat.plastic
-            if plastic:
-                cc = (T(mat.M), T(mat.beta), T(mat.xi), T(mat.p0_floor))
-            else:
-                cc = (T(0.0), T(0.0), T(0.0), T(0.0))
-            k_p2g = p2g_kernel(T, plastic, plastic and s.yielded is not None)
+            k_p2g = p2g_kernel(dim, T, mat.model, plastic and s.yielded is not None)
+            m_par = material_params(mat, T)
             for k, (a, b) in enumerate(_chunks(g.start, g.end, nt)):
                 if b <= a:
                     continue
@@ -114,16 +115,17 @@ class Stepper:
                     yld = s.yielded[psl] if s.yielded is not None else None
                 else:
                     ljp, yld = None, None
+                hz = s.hzz[sl] if s.hzz is not None else None
                 self._p2g[k].append(wp.launch(
                     k_p2g, b - a,
-                    inputs=[s.x[sl], s.v[sl], s.C[sl], s.F[sl], ljp, yld, T(g.mass), T(g.vol0), T(mat.mu),
-                            T(mat.lam), *cc, T(SINGULAR_VALUE_FLOOR), self.dt, origin, inv_dx, dx,
-                            self.grid_m_all[k], self.grid_p_all[k], self.edge_counts[k][1:]],
+                    inputs=[s.x[sl], s.v[sl], s.C[sl], s.H[sl], hz, ljp, yld, T(g.mass), T(g.vol0), m_par,
+                            self.dt, origin, inv_dx, dx, shape, self.grid_m_all[k], self.grid_p_all[k],
+                            self.counts[k]],
                     device=dev, record_cmd=True))
         self._grid = []
         for k, (a, b) in enumerate(_chunks(0, gs[0], nt)):
             self._grid.append(wp.launch(
-                grid_update_kernel(T, has_walls), (b - a, gs[1], gs[2]),
+                grid_update_kernel(dim, T, has_walls), (b - a, *gs[1:]),
                 inputs=[self.grid_m_all, self.grid_p_all, a, self.dt, s.clock, V(*model.gravity),
                         T(tc.gravity_ramp), T(tc.damping), T(tc.damping_until if tc.damping > 0 else 0.0),
                         T(model.mass_threshold), origin, dx, model.walls_device,
@@ -133,9 +135,9 @@ class Stepper:
         for k, (a, b) in enumerate(_chunks(0, model.n_particles, nt)):
             sl = slice(a, b)
             self._g2p.append(wp.launch(
-                g2p_kernel(T), b - a,
-                inputs=[s.x[sl], s.v[sl], s.C[sl], self.grid_p, self.dt, origin, inv_dx, dx, V(*model.x_lo),
-                        V(*model.x_hi), self.edge_counts[k]],
+                g2p_kernel(dim, T), b - a,
+                inputs=[s.x[sl], s.v[sl], s.C[sl], self.grid_p, self.dt, origin, inv_dx, dx, shape, V(*model.x_lo),
+                        V(*model.x_hi), self.counts[k]],
                 device=dev, record_cmd=True))
         self._end = wp.launch(end_step_kernel(), 1, inputs=[s.clock, s.steps], device=dev, record_cmd=True)
         self.use_graph = wp.get_device(dev).is_cuda if use_graph is None else use_graph
@@ -219,17 +221,22 @@ class Stepper:
         return float(c[0]), float(c[1]), int(self.state.steps.numpy()[0])
 
     def take_wall_impulse(self) -> np.ndarray:
-        """Impulse the material gave each wall since the last call (N s), then reset.
+        """Impulse the material gave each wall since the last call (N s; N s/m in 2D), then reset.
 
-        Divided by the elapsed time it is the mean force on the wall (N).
+        Divided by the elapsed time it is the mean force on the wall (N; N/m in 2D).
         """
         if self.wall_impulses is None:
-            return np.zeros((0, 3))
-        imp = self.wall_impulses.numpy().astype(np.float64).sum(axis=0)
+            return np.zeros((0, self.model.dim))
+        imp = self.wall_impulses.numpy().sum(axis=0)
         self.wall_impulses.zero_()
         return imp
 
     def edge_count(self) -> tuple[int, int]:
         """(particles clamped at the grid edge, particles skipped outside the grid) so far."""
-        e = self.edge_counts.numpy().sum(axis=0)
+        e = self.counts.numpy().sum(axis=0)
         return int(e[0]), int(e[1])
+
+    def deformation_events(self) -> tuple[int, int]:
+        """(singular-value floor events, inversions ``det F_tr <= 0``) counted by P2G so far."""
+        e = self.counts.numpy().sum(axis=0)
+        return int(e[2]), int(e[3])

@@ -14,7 +14,7 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Literal, get_args
 
-from .checks import choice, finite_number, vector3
+from .checks import choice, finite_number, vector
 
 __all__ = ["Wall", "WallKind", "WALL_KINDS", "box_walls"]
 
@@ -29,16 +29,16 @@ class Wall:
 
     Parameters
     ----------
-    point : (3,) float
+    point : (dim,) float
         A point of the plane at t = 0 (m).
-    normal : (3,) float
+    normal : (dim,) float
         Normal pointing into the material (normalised on validation).
     kind : {"sticky", "slip", "separate"}
         Boundary condition.
     friction : float
         Coulomb coefficient (-), used by ``"separate"``; >= 0.
-    velocity : (3,) float
-        Prescribed wall velocity (m/s).
+    velocity : (dim,) float or None
+        Prescribed wall velocity (m/s); None = at rest.
     ramp_time : float
         Time (s) over which the velocity ramps up linearly from zero; 0 = at once.
     name : str
@@ -49,19 +49,22 @@ class Wall:
     normal: tuple
     kind: WallKind = "slip"
     friction: float = 0.0
-    velocity: tuple = (0.0, 0.0, 0.0)
+    velocity: tuple | None = None
     ramp_time: float = 0.0
     name: str = "wall"
 
-    def validate(self, where: str = "wall") -> Wall:
-        """Return a checked copy with a unit normal; raise InvalidArgument on bad fields."""
-        p = vector3(f"{where}.point", self.point)
-        n = vector3(f"{where}.normal", self.normal, nonzero=True)
+    def validate(self, where: str = "wall", dim: int = 3) -> Wall:
+        """Return a checked copy with a unit normal; raise InvalidArgument on bad fields.
+
+        ``dim`` is the scene's dimension: every vector has ``dim`` components.
+        """
+        p = vector(f"{where}.point", self.point, dim)
+        n = vector(f"{where}.normal", self.normal, dim, nonzero=True)
         norm = math.sqrt(sum(c * c for c in n))
         n = tuple(c / norm for c in n)
         choice(f"{where}.kind", self.kind, WALL_KINDS)
         finite_number(f"{where}.friction", self.friction, lo=0.0)
-        v = vector3(f"{where}.velocity", self.velocity)
+        v = vector(f"{where}.velocity", (0.0,) * dim if self.velocity is None else self.velocity, dim)
         finite_number(f"{where}.ramp_time", self.ramp_time, lo=0.0)
         return Wall(p, n, self.kind, float(self.friction), v, float(self.ramp_time), str(self.name))
 
@@ -79,19 +82,21 @@ class Wall:
 
 
 def box_walls(lo, hi, kind: WallKind = "slip", friction: float = 0.0, faces: str = "xyz") -> list[Wall]:
-    """The faces of the box ``[lo, hi]`` as walls with inward normals.
+    """The faces of the box ``[lo, hi]`` (2 or 3 components) as walls with inward normals.
 
-    ``faces`` selects the axes whose two faces are walls (e.g. ``"xz"``).
+    ``faces`` selects the axes whose two faces are walls (e.g. ``"xz"``); axes
+    beyond the box's dimension are ignored.
     """
     names = "xyz"
+    dim = len(lo)
     walls = []
-    for a in range(3):
+    for a in range(dim):
         if names[a] not in faces:
             continue
-        n = [0.0, 0.0, 0.0]
+        n = [0.0] * dim
         n[a] = 1.0
         walls.append(Wall(tuple(lo), tuple(n), kind, friction, name=f"{names[a]}_lo"))
-        n = [0.0, 0.0, 0.0]
+        n = [0.0] * dim
         n[a] = -1.0
         walls.append(Wall(tuple(hi), tuple(n), kind, friction, name=f"{names[a]}_hi"))
     return walls

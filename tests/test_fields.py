@@ -97,7 +97,7 @@ def test_device_stress_field_equals_the_host_mirror_and_the_closed_form():
     F = np.eye(3) + 0.05 * rng.normal(size=(n, 3, 3))
     a = 1.02
     F[0] = np.diag([a, 1.0, 1.0])
-    sim.state.F.assign(F)
+    sim.state.set_elastic_deformation_gradient(F)
     sigma = sim.particle_field("stress")
     assert sigma.shape == (n, 3, 3)
     ref = cauchy_stress(F, snow.mu, snow.lam)
@@ -126,4 +126,5 @@ def test_stress_field_in_a_run_file(tmp_path):
     np.testing.assert_allclose(s, np.transpose(s, (0, 2, 1)), atol=1e-6 * np.abs(s).max())    # symmetric
     reader = FieldReader(run)
     np.testing.assert_array_equal(reader.values("sigma_yy", run.frame(-1)), s[:, 1, 1].astype(float))
-    assert s[:, 1, 1].mean() < 0.0                                                 # the block rests on the floor
+    # at t = 0.06 s the block (released 0.1 m above the floor) is still falling: a free fall carries no stress
+    assert np.abs(s).max() < 0.01 * 250.0 * 9.81 * 0.1

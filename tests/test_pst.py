@@ -126,10 +126,10 @@ def test_weak_layer_brittle_failure_kernel():
     K = lam + 2 * mu / 3
     xi, M, beta, p0_ini = 0.0066, 1.2, 0.3, 3000.0
     lj0 = -math.asinh(p0_ini / K) / xi
-    Fs = np.tile(np.eye(3, dtype=np.float32), (3, 1, 1))
-    Fs[1, 0, 1] = 0.001  # small shear: inside the ellipse
-    Fs[2, 0, 1] = 0.02   # large shear: q = mu * 0.02 ~ 7.7 kPa > q_max (~2 kPa): on or beyond the surface
-    F = wp.array(Fs, dtype=mat33(T), device=DEVICE)
+    Hs = np.zeros((3, 3, 3), dtype=np.float32)  # the kernel reads H = F_E - I
+    Hs[1, 0, 1] = 0.001  # small shear: inside the ellipse
+    Hs[2, 0, 1] = 0.02   # large shear: q = mu * 0.02 ~ 7.7 kPa > q_max (~2 kPa): on or beyond the surface
+    F = wp.array(Hs, dtype=mat33(T), device=DEVICE)
     log_jp = wp.array(np.full(3, lj0, np.float32), dtype=T, device=DEVICE)
     ref = wp.zeros(3, dtype=T, device=DEVICE)
     failed = wp.zeros(3, dtype=wp.uint8, device=DEVICE)

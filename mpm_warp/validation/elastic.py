@@ -194,7 +194,7 @@ def self_weight_column(dx: float = 1.0 / 16.0, *, cfl: float = 0.4, dt: float | 
 
     def sample(s, frame):
         if s.time > t_avg:
-            samples.append(cauchy_stress(s.state.F.numpy(), mat.mu, mat.lam)[:, 1, 1])
+            samples.append(cauchy_stress(s.state.elastic_deformation_gradient(), mat.mu, mat.lam)[:, 1, 1])
 
     res = sim.run(None, callback=sample)
     syy = np.mean(samples, axis=0)

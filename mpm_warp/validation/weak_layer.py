@@ -156,7 +156,7 @@ def measure_column(sim: Simulation, wl: CamClaySnow, info: dict) -> dict:
     g = next(gr for gr in sim.model.groups if gr.name == "weak_layer")
     sl = slice(g.start, g.end)
     ljp = sim.particle_field("log_jp")[sl].astype(np.float64)
-    F = sim.state.F.numpy()[sl].astype(np.float64)
+    F = sim.state.elastic_deformation_gradient()[sl]
     tau = kirchhoff_stress(F, wl.mu, wl.lam)
     p, q = pressure_and_mises(tau)
     tau_v = -tau[:, 1, 1]

@@ -62,8 +62,8 @@ class ShearMonitor(SeriesMonitor):
         t = sim.time
         u = (self.load.x.numpy().astype(np.float64) - self.load.x0).mean(axis=0)
         wl = self.weak.group
-        p, q = sim.stress_invariants()
-        sxy = sim.cauchy_stress("weak_layer")[:, 0, 1].astype(np.float64)
+        p, q, sigma = sim.stresses(cauchy=True)
+        sxy = sigma[wl.start:wl.end, 0, 1].astype(np.float64)
         c, flag = self.weak.collapse()
         d_wl = float(self.params.weak_layer_thickness)
         imp = float(self.impulse.numpy()[0])

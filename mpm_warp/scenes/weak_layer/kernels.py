@@ -31,7 +31,8 @@ def weak_layer_kernel(T):
     again: the collapse of the anticrack, ``1 - J_P = 1 - exp(-asinh(p/K)/xi)``
     on the cap. A particle fails once; before ``t_ref`` (settling) only the
     engine's model acts.
-    Stress from the SVD of ``F_E`` (Hencky, Kirchhoff, Pa).
+    Stress from the SVD of ``F_E = I + H`` (Hencky, Kirchhoff, Pa); ``H = F_E - I`` is the engine's
+    elastic state (3D scenes: the snow scenes are one cell thick, not plane-strain 2D).
     """
     V = vec3(T)
     M33 = mat33(T)
@@ -40,7 +41,7 @@ def weak_layer_kernel(T):
     yield_fn = camclay_yield_func(T)
 
     @wp.kernel(enable_backward=False)
-    def weak_layer(F: wp.array(dtype=M33), log_jp: wp.array(dtype=T), ref: wp.array(dtype=T),
+    def weak_layer(H: wp.array(dtype=M33), log_jp: wp.array(dtype=T), ref: wp.array(dtype=T),
                    failed: wp.array(dtype=wp.uint8), clock: wp.array(dtype=wp.float64), t_ref: wp.float64,
                    brittle: wp.int32, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T, log_jp_failed: T,
                    tol: T):
@@ -50,7 +51,7 @@ def weak_layer_kernel(T):
             U = M33()
             sig = V()
             Vt = M33()
-            wp.svd3(F[i], U, sig, Vt)
+            wp.svd3(wp.identity(3, dtype=T) + H[i], U, sig, Vt)
             p, q = pq(sig, mu, lam)
             K = lam + T(2.0) / T(3.0) * mu
             p0 = p0_fn(lj, K, xi, p0_floor)

@@ -51,7 +51,7 @@ class WeakLayerTracker:
         self.failed = wp.zeros(view.count, dtype=wp.uint8, device=sim.device)
         self.launch = wp.launch(
             weak_layer_kernel(T), view.count,
-            inputs=[view.F, self.log_jp, self.ref, self.failed, sim.clock, float(t_ref), int(params.brittle),
+            inputs=[view.H, self.log_jp, self.ref, self.failed, sim.clock, float(t_ref), int(params.brittle),
                     T(m.mu), T(m.lam), T(m.M), T(m.beta), T(m.xi), T(m.p0_floor), T(params.failure_log_jp),
                     T(self.YIELD_TOL)],
             device=sim.device, record_cmd=True)
