@@ -88,7 +88,7 @@ TINY_PST = ["scene.length=0.6", "scene.slab_thickness=0.15", "scene.saw.cut_leng
 #: a small shear test (560 particles): settled by 0.05 s, pushed from then on, run to 0.09 s
 TINY_SHEAR = ["scene.dx=0.01", "scene.sample_length=0.1", "scene.settle.gravity_ramp=0.03",
               "scene.settle.duration=0.05", "time.end=0.09", "time.frame_interval=0.005",
-              "output.checkpoint_every=1"]
+              "output.checkpoint_every=1", 'output.fields=["x", "log_jp"]']
 
 
 def _same_result(a: dict, b: dict) -> None:
@@ -142,6 +142,7 @@ def test_shear_test_interrupted_while_pushing_resumes_bit_for_bit(tmp_path):
     ck = "monitors/shear_test/device/"
     assert arrays[ck + "impulse"][0] != 0.0 and arrays[ck + "last"][0] == pytest.approx(0.07)
     assert res.monitor.series["shear_stress"][-1] != 0.0
+    assert "log_jp_ref" in mw.read_run(str(tmp_path / "part.h5")).particle_fields     # compared frame by frame
 
 
 def test_resume_on_another_thread_count(tmp_path):

@@ -9,7 +9,7 @@ import warp as wp
 
 from ..fronts import front_from_arrival
 from ..series import SeriesMonitor
-from ..weak_layer import SAWN, WeakLayerTracker
+from ..weak_layer import SAWN, ReferenceField, WeakLayerTracker
 from .analysis import pst_summary
 from .kernels import pst_action_kernel
 from .params import PSTParams
@@ -17,7 +17,7 @@ from .params import PSTParams
 __all__ = ["PSTMonitor", "attach"]
 
 
-class PSTMonitor(SeriesMonitor):
+class PSTMonitor(ReferenceField, SeriesMonitor):
     """The saw, the front trackers and the frame diagnostics of one PST simulation.
 
     Frame scalars (stored in the run file): ``front`` (m from the cut end, the collapse criterion of
@@ -74,7 +74,6 @@ class PSTMonitor(SeriesMonitor):
         self.markers = p.markers()
         #: index of each marker's particle within the slab group
         self.marker_index = zc[np.argmin(np.abs(x0[zc, 0][None, :] - self.markers[:, None]), axis=1)]
-        self._with_ref = "log_jp" in sim.scenario.output.fields
 
     # ----------------------------------------------------------------- contract
     def actions(self) -> list:
@@ -102,17 +101,6 @@ class PSTMonitor(SeriesMonitor):
         for k in range(len(self.markers)):
             out[f"marker{k}_ux"] = float(u[k, 0])
             out[f"marker{k}_uy"] = float(u[k, 1])
-        return out
-
-    def particle_fields(self) -> dict[str, tuple[tuple, str]]:
-        """``log_jp_ref`` (-), the collapse reference, when the output holds ``log_jp``."""
-        return {"log_jp_ref": ((), "1")} if self._with_ref else {}
-
-    def particle_field(self, name: str) -> np.ndarray:
-        """``log_jp_ref`` of every particle: the weak layer's reference, ``log_jp`` elsewhere (collapse 0)."""
-        out = self.sim.particle_field("log_jp")
-        wl = self.weak.group
-        out[wl.start:wl.end] = self.weak.ref.numpy()
         return out
 
     def device_state(self) -> dict[str, np.ndarray]:

@@ -6,7 +6,7 @@ import numpy as np
 import warp as wp
 
 from ..series import SeriesMonitor
-from ..weak_layer import WeakLayerTracker
+from ..weak_layer import ReferenceField, WeakLayerTracker
 from .analysis import analyze_shear_series
 from .kernels import push_kernel
 from .params import ShearTestParams
@@ -14,7 +14,7 @@ from .params import ShearTestParams
 __all__ = ["ShearMonitor", "attach"]
 
 
-class ShearMonitor(SeriesMonitor):
+class ShearMonitor(ReferenceField, SeriesMonitor):
     """The push, the weak layer's failure rule and the frame diagnostics of one shear test.
 
     Frame scalars: ``shear_displacement`` and ``normal_displacement`` (m, mean displacement of the
@@ -25,7 +25,8 @@ class ShearMonitor(SeriesMonitor):
     Cauchy ``sigma_xy`` of the weak-layer particles from the device's stress field: lower, since the
     free ends carry none and part of the push reaches the layer's top through the shared grid
     nodes), ``mises_q``/``p_mean`` (Pa, mean Mises stress and pressure of the weak layer, Kirchhoff),
-    ``collapse`` (-, mean ``1 - J_P/J_P,ref`` of the layer) and ``failed_fraction`` (-).
+    ``collapse`` (-, mean ``1 - J_P/J_P,ref`` of the layer) and ``failed_fraction`` (-). Per-frame particle
+    field (with ``log_jp`` in the output): ``log_jp_ref``, the collapse reference.
     """
 
     name = "shear_test"
@@ -39,6 +40,7 @@ class ShearMonitor(SeriesMonitor):
         if not isinstance(p, ShearTestParams):
             raise TypeError("ShearMonitor needs a scenario built by mpm_warp.scenes.shear_test.build")
         self.params = p
+        self.sim = sim
         T = sim.model.T
         self.weak = WeakLayerTracker(sim, "weak_layer", p.push_start, p.weak_layer)
         self.load = sim.group_state("load")

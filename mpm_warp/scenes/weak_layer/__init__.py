@@ -12,7 +12,8 @@ Everything about the weak layer's scene physics lives here (the engine's Cam-Cla
   front stops at the saw). Gaume et al. (2018) obtain the softening with a non-associative flow rule;
   this rule is its brittle limit, implemented without touching the engine;
 - :mod:`.tracker`: :class:`WeakLayerTracker`, the device arrays (reference, failure flags) of one
-  run and their checkpoint state.
+  run and their checkpoint state; :class:`ReferenceField`, the ``log_jp_ref`` output field of a
+  monitor (the collapse reference of :mod:`mpm_warp.post.fields`).
 
 Replacing the weak layer's physics means replacing these three modules; the PST and shear-test
 scenes use them through :class:`WeakLayer` and :class:`WeakLayerTracker` only.
@@ -20,6 +21,7 @@ scenes use them through :class:`WeakLayer` and :class:`WeakLayerTracker` only.
 
 from .kernels import weak_layer_kernel
 from .params import FAILURE_RULES, WeakLayer
-from .tracker import FAILED, INTACT, SAWN, WeakLayerTracker
+from .tracker import FAILED, INTACT, SAWN, ReferenceField, WeakLayerTracker
 
-__all__ = ["WeakLayer", "WeakLayerTracker", "weak_layer_kernel", "FAILURE_RULES", "INTACT", "FAILED", "SAWN"]
+__all__ = ["WeakLayer", "WeakLayerTracker", "ReferenceField", "weak_layer_kernel", "FAILURE_RULES", "INTACT",
+           "FAILED", "SAWN"]

@@ -9,7 +9,7 @@ from ..fronts import collapse_fraction
 from .kernels import weak_layer_kernel
 from .params import WeakLayer
 
-__all__ = ["WeakLayerTracker", "SAWN", "FAILED", "INTACT"]
+__all__ = ["WeakLayerTracker", "ReferenceField", "SAWN", "FAILED", "INTACT"]
 
 #: values of the per-particle failure flag
 INTACT, FAILED, SAWN = 0, 1, 2
@@ -69,3 +69,25 @@ class WeakLayerTracker:
         """Restore :meth:`state` into the device arrays."""
         self.ref.assign(state["ref"])
         self.failed.assign(state["failed"])
+
+    def reference_field(self, sim) -> np.ndarray:
+        """``log_jp_ref`` of every particle (N,): this layer's reference, ``log_jp`` elsewhere (no collapse there)."""
+        out = sim.particle_field("log_jp")
+        out[self.group.start:self.group.end] = self.ref.numpy()
+        return out
+
+
+class ReferenceField:
+    """Monitor mixin: the per-frame particle field ``log_jp_ref`` (-) of its ``weak`` tracker.
+
+    Written when the output holds ``log_jp``; the collapse of :mod:`mpm_warp.post.fields` is measured
+    from it. Needs the attributes ``sim`` and ``weak`` (a :class:`WeakLayerTracker`).
+    """
+
+    def particle_fields(self) -> dict[str, tuple[tuple, str]]:
+        """``log_jp_ref`` (-), the collapse reference, when the output holds ``log_jp``."""
+        return {"log_jp_ref": ((), "1")} if "log_jp" in self.sim.scenario.output.fields else {}
+
+    def particle_field(self, name: str) -> np.ndarray:
+        """The field ``name`` (``log_jp_ref``) of every particle."""
+        return self.weak.reference_field(self.sim)
