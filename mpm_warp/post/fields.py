@@ -4,8 +4,8 @@
 name               definition                                   unit   reference state
 =================  ===========================================  =====  ====================================
 ``collapse``       ``1 - exp(log_jp - log_jp_ref)``: plastic     -      the run's ``log_jp_ref`` field when
-                   volume lost since the reference (dilation,           stored (a PST with ``log_jp`` in its
-                   and a sawn cut, are negative)                        output: the weak layer's state at the
+                   volume lost since the reference (dilation,           stored (a snow scene with ``log_jp`` in
+                   and a sawn cut, are negative)                        its output: the weak layer's state at the
                                                                         end of settling, or right after a
                                                                         brittle failure; ``log_jp`` elsewhere),
                                                                         else the initial state (frame 0)
@@ -19,8 +19,8 @@ name               definition                                   unit   reference
 The collapse of the weak layer is measured from its settled state, not from ``log_jp = 0``: the
 initial consolidation (``log_jp(0) = -asinh(p0_ini/K)/xi``) is not a collapse, and the brittle
 failure rule resets ``log_jp`` (a hardening state, not a volume change), so ``1 - exp(log_jp)`` would
-show the intact layer as the most collapsed. The PST monitor stores ``log_jp_ref`` per frame (it
-changes where particles fail); ``1 - exp(log_jp - log_jp_ref)`` is then the compaction behind the
+show the intact layer as the most collapsed. The PST and shear-test monitors store ``log_jp_ref``
+per frame (it changes where particles fail); ``1 - exp(log_jp - log_jp_ref)`` is then the compaction behind the
 front that the front criterion of :mod:`mpm_warp.scenes.pst` uses.
 """
 
