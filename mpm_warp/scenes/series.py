@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SeriesMonitor"]
+__all__ = ["SeriesMonitor", "entries_below"]
 
 
 class SeriesMonitor:
@@ -77,10 +77,15 @@ class SeriesMonitor:
 
     def load_state(self, state: dict[str, np.ndarray]) -> None:
         """Restore :meth:`state`."""
-        self.load_device_state({k[7:]: v for k, v in state.items() if k.startswith("device/")})
+        self.load_device_state(entries_below(state, "device/"))
         self.times = [float(t) for t in state["series/times"]]
-        self.series = {k[14:]: [float(x) for x in v] for k, v in state.items() if k.startswith("series/values/")}
+        self.series = {k: [float(x) for x in v] for k, v in entries_below(state, "series/values/").items()}
 
     def series_arrays(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """The recorded times (s) and series as arrays."""
         return np.asarray(self.times, dtype=float), {k: np.asarray(v, dtype=float) for k, v in self.series.items()}
+
+
+def entries_below(state: dict, prefix: str) -> dict:
+    """The entries of ``state`` under ``prefix``, with the prefix removed from their names."""
+    return {k[len(prefix):]: v for k, v in state.items() if k.startswith(prefix)}

@@ -8,7 +8,7 @@ import numpy as np
 import warp as wp
 
 from ..fronts import front_from_arrival
-from ..series import SeriesMonitor
+from ..series import SeriesMonitor, entries_below
 from ..weak_layer import SAWN, ReferenceField, WeakLayerTracker
 from .analysis import pst_summary
 from .kernels import pst_action_kernel
@@ -110,7 +110,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
 
     def load_device_state(self, state: dict[str, np.ndarray]) -> None:
         """Restore :meth:`device_state`."""
-        self.weak.load_state({k[11:]: v for k, v in state.items() if k.startswith("weak_layer/")})
+        self.weak.load_state(entries_below(state, "weak_layer/"))
         self.arrival.assign(state["arrival"])
         self.arrival_failure.assign(state["arrival_failure"])
 

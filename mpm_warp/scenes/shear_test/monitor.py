@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from ..series import SeriesMonitor
+from ..series import SeriesMonitor, entries_below
 from ..weak_layer import ReferenceField, WeakLayerTracker
 from .analysis import analyze_shear_series
 from .kernels import push_kernel
@@ -85,7 +85,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
 
     def load_device_state(self, state: dict[str, np.ndarray]) -> None:
         """Restore :meth:`device_state`."""
-        self.weak.load_state({k[11:]: v for k, v in state.items() if k.startswith("weak_layer/")})
+        self.weak.load_state(entries_below(state, "weak_layer/"))
         self.impulse.assign(state["impulse"])
         self._last = (float(state["last"][0]), float(state["last"][1]))
 
