@@ -249,9 +249,9 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
         state ``F_E - I`` in the driver's precision (the engine's particle state); ``log_jp``;
         ``p``, ``q`` (Pa, Kirchhoff, compression positive); ``p0`` (Pa; Cam-Clay); ``stress``
         (..., 3, 3) Cauchy (Pa); ``eps_trial``, ``eps`` (..., 3): principal Hencky strains of the
-        trial and of the new state (in-plane first, then zz in 2D); ``yielded`` (int32); ``L`` (n_points, n_increments, d, d)
-        the increments used (solved entries included); ``control_residual`` (Pa, the
-        largest controlled-stress error left at each increment).
+        trial and of the new state (in-plane first, then zz in 2D); ``yielded`` (int32);
+        ``L`` (n_points, n_increments, d, d) the increments used (solved entries included);
+        ``control_residual`` (Pa, the largest controlled-stress error left at each increment).
 
     Raises
     ------
