@@ -245,12 +245,13 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
     Returns
     -------
     dict of numpy.ndarray, index 0 the initial state, shape ``(n_points, n_increments + 1, ...)``
-        ``F_E`` (..., 3, 3); ``log_jp``; ``p``, ``q`` (Pa, Kirchhoff, compression positive);
-        ``p0`` (Pa; Cam-Clay); ``stress`` (..., 3, 3) Cauchy (Pa); ``eps_trial``, ``eps``
-        (..., 3): principal Hencky strains of the trial and of the new state (descending
-        in-plane, then zz in 2D); ``yielded`` (int32); ``L`` (n_points, n_increments, d, d)
-        the increments used (solved entries included); ``control_residual`` (Pa, the
-        largest controlled-stress error left at each increment).
+        ``F_E`` (..., 3, 3); ``H`` (..., d, d) and, in plane strain, ``hzz``: the stored elastic
+        state ``F_E - I`` in the driver's precision (the engine's particle state); ``log_jp``;
+        ``p``, ``q`` (Pa, Kirchhoff, compression positive); ``p0`` (Pa; Cam-Clay); ``stress``
+        (..., 3, 3) Cauchy (Pa); ``eps_trial``, ``eps`` (..., 3): principal Hencky strains of the
+        trial and of the new state (in-plane first, then zz in 2D); ``yielded`` (int32);
+        ``L`` (n_points, n_increments, d, d) the increments used (solved entries included);
+        ``control_residual`` (Pa, the largest controlled-stress error left at each increment).
 
     Raises
     ------
@@ -332,7 +333,9 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
                                         "p0", "L", "control_residual")],
               device=device)
     res = {k: a.numpy() for k, a in out.items()}
-    H, hzz = res.pop("H").astype(np.float64), res.pop("hzz").astype(np.float64)
+    if dim == 3:
+        res.pop("hzz")
+    H, hzz = res["H"].astype(np.float64), out["hzz"].numpy().astype(np.float64)
     F = np.zeros((n_pts, n_inc + 1, 3, 3))
     F[..., :dim, :dim] = H
     F[..., range(3), range(3)] += 1.0

@@ -175,7 +175,10 @@ class Model:
             self._seed.append((b, x))
         self.n_particles = start
         self.n_plastic = pstart
-        self.mass_threshold = 1e-9 * min(g.mass for g in self.groups)
+        # nodes lighter than this are empty. The node velocity (sum w (m v + A dpos)) / (sum w m) is well defined for
+        # any positive mass, so the threshold only keeps float32 away from denormals (1e-20 of a particle's mass);
+        # dropping nodes a particle reaches with a weight of 1e-9 broke momentum conservation at 1e-10
+        self.mass_threshold = 1e-20 * min(g.mass for g in self.groups)
         self.has_plastic = self.n_plastic > 0
 
         self.walls_device = None

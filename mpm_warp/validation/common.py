@@ -16,9 +16,9 @@ G = 9.81
 
 # ------------------------------------------------------------------ measuring
 def com_velocity(sim: Simulation) -> np.ndarray:
-    """Mass-weighted mean particle velocity (m/s), shape (3,)."""
+    """Mass-weighted mean particle velocity (m/s), shape (dim,)."""
     v = sim.state.v.numpy().astype(np.float64)
-    p = np.zeros(3)
+    p = np.zeros(v.shape[1])
     m = 0.0
     for g in sim.model.groups:
         p += g.mass * v[g.start:g.end].sum(axis=0)
