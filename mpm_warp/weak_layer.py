@@ -60,6 +60,7 @@ from .weak_layer_paths import (
     bond_pressure_for_shear_strength,
     collapse_law,
     compressive_strength,
+    elastic_shear_state,
     loaded_shear_test,
     oedometric_collapse,
     shear_strength,
@@ -298,6 +299,14 @@ def weak_layer_material(*, E: float, nu: float, density: float, D_wl: float, M: 
                               f"a strength at which the intact layer carries the slab (its oedometric strength "
                               f"{sigma_c:.4g} Pa is below sigma_n = {sigma_n:.4g} Pa)")
     tau_first = shear_strength(mat0, sigma_n)
+    # a shear failure: the first-yield state on the dilatant side of the apex, so that the bond softens from the
+    # peak on; on the compaction side the slab nearly crushes the layer and the shear test hardens first
+    p_y = elastic_shear_state(mat0, sigma_n, tau_first)[2]
+    if p_y >= 0.5 * mat0.p0_ini * (1.0 - beta):
+        strength = ("tau_p", tau_p) if "tau_p" in given else ("p_bond", p_bond)
+        raise InvalidArgument(*strength, f"a strength at which the layer fails in shear under sigma_n = "
+                                         f"{sigma_n:.4g} Pa (here it yields in compaction: tau_p = {tau_first:.4g} Pa, "
+                                         f"oedometric strength {sigma_c:.4g} Pa); raise it")
 
     # fracture energy or softening slip -> kappa_s (secant in ln kappa_s on the shear test). Start: the plastic
     # slip sqrt(2) D_wl kappa_s of pure shear, of which the collapse cuts off the last ~40 %, at a mean shear
@@ -314,6 +323,8 @@ def weak_layer_material(*, E: float, nu: float, density: float, D_wl: float, M: 
     while True:
         mat = replace(mat0, kappa_s=k)
         r = _measure(mat, sigma_n, D_wl, n)
+        if not r[key] > 0.0:
+            raise InvalidArgument(key, target, f"a value the shear test can reach (it gives {r[key]:.4g})")
         err = math.log(r[key] / target)
         hist.append((math.log(k), err))
         if abs(err) <= CALIBRATION_RTOL:
