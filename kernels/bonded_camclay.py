@@ -40,37 +40,43 @@ Return mapping (MODEL.md 4, SI Note 1), fully implicit. The discrete flow rule
 ``eps_tr - eps_new = dgamma dy/dtau`` is solved with the surface of the *new*
 state ``(log_Jp_new, kappa_new)``: the new ``(p, q)`` is the point of the
 ellipse of the new state closest to the trial in the energy metric
-``dp^2/K + dq^2/(3 mu)``. Two nested scalar root finds:
+``dp^2/K + dq^2/(3 mu)``. Two nested scalar root finds around camclay's
+closest-point solver:
 
 * volumetric (bond fixed): ``g(L) = L - L_n - (p*(L) - p_tr)/K = 0``, ``p*(L)``
-  the closest point on the ellipse of ``p0_int(L) + b p_bond``. ``g`` is
-  continuous and increasing; a bracket follows from ``p*`` lying between the
-  trial and the apex ``pc = p0 (1 - beta_e)/2``: ``L`` between ``L_n`` and
-  ``L_n + (pc(L_n) - p_tr)/K`` (needs ``beta <= 1``). Safeguarded Newton with
-  the exact derivative: with the bond fixed the ellipse is a homothety of
-  ``p0`` about the origin, so in the Euclidean coordinates ``(p, q/rho)``,
-  ``rho = sqrt(3 mu/K)``, ``dZ/dp0 = [Z - t (t.Z)/(1 + d k)]/p0`` (``Z`` the
-  closest point, ``t`` its unit tangent, ``d`` the distance to the trial, ``k``
-  the curvature there);
+  the closest point on the ellipse of ``p0_int(L) + b p_bond``. A root lies
+  between ``L_n`` and ``L_n + (pc(L_n) - p_tr)/K`` (``p*`` lies between the trial
+  and the apex ``pc = p0 (1 - beta_e)/2``, which moves the right way when
+  ``beta <= 1``). Newton with the exact derivative, kept in that bracket: with
+  the bond fixed the ellipse is a homothety of ``p0`` about the origin, so in
+  the Euclidean coordinates ``(p, q/rho)``, ``rho = sqrt(3 mu/K)``,
+  ``dZ/dp0 = [Z - t (t.Z)/(1 + d k)]/p0`` (``Z`` the closest point, ``t`` its
+  unit tangent, ``d`` its distance to the trial, ``k`` the curvature there).
+  Where ``g`` decreases (dilation softening faster than the elasticity,
+  ``(1 - beta)/2 xi cosh(xi x) > 1`` on the dry side: several roots), doubling
+  steps walk to the sign change nearest the start instead;
 * bond: ``f(kappa) = kappa - kappa_n - dkappa(kappa) = 0`` with the volumetric
   problem solved inside; ``dkappa`` grows with ``kappa`` (a weaker surface is
-  farther), so the fixed-point map is increasing; its slope is below 1 unless
-  the softening outruns the elasticity (material snap-back, excluded by the
-  calibration). Secant steps from ``kappa_n`` and the explicit estimate,
-  bracketed by ``[kappa_n, max(kappa_s, kappa_n + dkappa(b = 0))]`` with
-  bisection as the fall-back.
+  farther), its slope stays below 1 unless the softening outruns the
+  elasticity (material snap-back, which the calibration of
+  :mod:`mpm_warp.weak_layer` does not produce). Secant steps from ``kappa_n`` and
+  the explicit estimate (the projection on the current surface), kept in
+  ``[kappa_n, max(kappa_s, kappa_n + dkappa(b = 0))]`` with bisection as the
+  fall-back.
 
-Both ends of the update are implicit, so: no period-2 cycling of the explicit
-hardening (camclay cycles when ``(1 - beta)/2 xi cosh(xi x) > 1`` and the
-increment is large), the returned state lies on its own surface (projecting
-again changes nothing), and the bond drops by what the increment's plastic
-strain costs, not by what an explicit projection on the intact surface
-would claim. The elastic trial is one yield check and returns its inputs bit
-for bit.
+Both stop on their residual (``g``, ``f``) at its rounding level, about
+``2 eps (1 + |state|)``, so the returned state lies on its own surface: no
+period-2 cycling of an explicit hardening (camclay cycles when ``(1 - beta)/2
+xi cosh(xi x) > 1`` and the increment is large), projecting again changes
+nothing, and the bond drops by what the increment's plastic strain costs. A
+yielding point costs a projection plus two or three (bond) times two
+(volumetric) Newton evaluations: 5.2x camclay's return at a crack tip, 2.5x
+once the bond is gone (CPU, float32, ``benchmarks/bonded_return_cost.py``). The
+elastic trial is one yield check and returns its inputs bit for bit.
 
 Numerical constants (fixed, not model parameters): ``SINGULAR_VALUE_FLOOR``
 and the ``p0_int`` cap as camclay; at most :data:`_MAX_ITERATIONS` iterations
-per root find (typically 2-4 Newton steps inside, 2-4 secant steps outside).
+per root find.
 """
 
 import functools
@@ -337,6 +343,7 @@ def bonded_camclay_return_func(T):
     p0_fn = bonded_p0_func(T)
     bond = bond_func(T)
     solve = _volumetric_solve_func(T)
+    project = _project_func(T)
 
     @wp.func
     def dkappa(p: T, q: T, p_tr: T, q_tr: T, K: T, mu: T):
@@ -361,9 +368,14 @@ def bonded_camclay_return_func(T):
         if yield_fn(p_tr, q_tr, p0, M, beta * b_n) <= T(0.0):
             return sig, log_jp, kappa, wp.int32(0)
 
-        # bond at kappa_n: the explicit estimate dk0 of the increment
-        L, p, q = solve(p_tr, q_tr, log_jp, log_jp, b_n, K, mu, M, beta, xi, p0_floor, p_bond)
-        if b_n > T(0.0):
+        L = log_jp
+        p = p_tr
+        q = q_tr
+        if b_n <= T(0.0):  # bond gone: the volumetric problem alone
+            L, p, q = solve(p_tr, q_tr, log_jp, log_jp, b_n, K, mu, M, beta, xi, p0_floor, p_bond)
+        else:
+            # the explicit estimate dk0 of the increment: projection on the current surface
+            p, q, dp = project(p_tr, q_tr, p0, beta * b_n, M, K, mu)
             dk0 = dkappa(p, q, p_tr, q_tr, K, mu)
             # secant on f(k) = k - kappa - dkappa(k) from (kappa, -dk0) and kappa + dk0, kept in the
             # bracket [lo, hi] (f(lo) <= 0 <= f(hi)); the upper end max(kappa_s, kappa + dkappa(b = 0))

@@ -7,14 +7,14 @@ of ``y`` for a strain error of one unit roundoff ``u`` times ``S = 1 + max |ln
 sig|``, a relative error ``u`` on the ellipse, and, new here, a rounding of the
 state that sets the surface (``p0`` moves by ``|dp0/dlog_Jp| u (1 + |log_Jp| +
 S)`` and ``(p_bond/kappa_s) u (kappa + S)``; ``|dp0/dlog_Jp|`` reaches ~10 p0 for
-the steepest hardening drawn). Worst seen over 2 x 4000 random states: 1.5 Y_u
+the steepest hardening drawn). Worst seen over 2 x 4000 random states: 3.1 Y_u
 (float32), 3.6 Y_u (float64); bound 8 Y_u as camclay. Re-projecting a result
 with its own state moved ``ln sig`` by at most 21 u (float32) and 38 u
 (float64); bound 64 u (1 + max |ln sig|) as camclay. The float64 return agrees
 with an independent NumPy reference (nested Illinois root finds on the plastic
 multiplier of the classical Cam-Clay form ``p(dgamma), q(dgamma)``, the
 intrinsic state and the bond) to 2.7 rounding units in ``p, q`` (units ``u K``,
-``u mu``) and 8.5 in ``kappa`` (units ``u kappa_s``); bound 64.
+``u mu``) and 4.5 in ``kappa`` (units ``u kappa_s``); bound 64.
 """
 
 import functools
