@@ -30,7 +30,7 @@ def scenarios_dir() -> str:
 
 from .errors import InvalidArgument, MPMError, OutputError, ScenarioError, SimulationBlowUp  # noqa: E402
 from .io import RunData, read_run  # noqa: E402
-from .materials import CamClaySnow, Elastic  # noqa: E402
+from .materials import BondedCamClay, CamClaySnow, Elastic  # noqa: E402
 from .scenario import Block, Domain, Output, Scenario, TimeControl, apply_overrides, load_scenario  # noqa: E402
 from .simulation import RunResult, Simulation, resume  # noqa: E402
 from .walls import Wall, box_walls  # noqa: E402
@@ -44,8 +44,8 @@ def run(scenario, output: str | None = None, device: str | None = None, override
 
 
 __all__ = [
-    "Block", "CamClaySnow", "Domain", "Elastic", "InvalidArgument", "MPMError", "Output", "OutputError",
-    "RunData", "RunResult", "Scenario", "ScenarioError", "Simulation", "SimulationBlowUp", "TimeControl",
+    "Block", "BondedCamClay", "CamClaySnow", "Domain", "Elastic", "InvalidArgument", "MPMError", "Output",
+    "OutputError", "RunData", "RunResult", "Scenario", "ScenarioError", "Simulation", "SimulationBlowUp", "TimeControl",
     "Wall", "apply_overrides", "box_walls", "load_scenario", "read_run", "resume", "run", "scenarios_dir",
     "__version__",
 ]

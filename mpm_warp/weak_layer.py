@@ -28,8 +28,12 @@ Definitions, all in the reference tests of :mod:`mpm_warp.weak_layer_paths`
   et al. 2016, Bergfeld et al. 2021, 2023); ``delta_s``: that plastic slip (about
   2 mm: Gaume et al. 2018 SI Note 2; McClung 1977; 3.5 mm in Bazant et al. 2003);
 * ``h_c``: the collapse of the debonded layer at rest under ``sigma_n`` in
-  uniaxial strain, ``h_c = (1 - J_P/J_P(0)) D_wl`` (Gaume et al. 2018 SI Note 3;
-  WEAC fit to PST measurements: Rosendahl and Weissgraeber 2020).
+  uniaxial strain, ``h_c = (1 - J_P/J_P(0)) D_wl`` (Gaume et al. 2018 SI Note 3).
+  Default: the fit of WEAC (Rosendahl and Weissgraeber 2020; ``weac``'s
+  ``_collapse_height``) to the PST collapse heights of van Herwijnen et al. (2016).
+
+For comparison, WEAC's mixed-mode weak-layer toughnesses are ``G_Ic = 0.56``
+and ``G_IIc = 0.79`` J/m^2; ``w_f`` here is the shear (mode II) one.
 
 Conversions:
 
@@ -52,6 +56,8 @@ the collapse, and the critical cut length on flat ground (Gaume et al. 2017)
 import math
 from dataclasses import asdict, dataclass, field, replace
 
+import numpy as np
+
 from .errors import InvalidArgument
 from .materials import BondedCamClay
 from .validate import finite_number
@@ -67,7 +73,8 @@ from .weak_layer_paths import (
     xi_for_collapse,
 )
 
-__all__ = ["WeakLayer", "weak_layer_material", "weac_collapse_height", "critical_cut_length", "CALIBRATION_RTOL"]
+__all__ = ["WeakLayer", "weak_layer_material", "weac_collapse_height", "critical_cut_length", "layer_columns",
+           "CALIBRATION_RTOL"]
 
 CALIBRATION_RTOL = 1e-3
 """Relative tolerance of the ``kappa_s`` calibration on ``w_f`` or ``delta_s``."""
@@ -78,6 +85,29 @@ _MAX_CALIBRATION_RUNS = 12
 def weac_collapse_height(D_wl: float) -> float:
     """WEAC fit of the weak-layer collapse height ``h_c = 4.70 (1 - exp(-D_wl / 7.78 mm)) mm`` (m; ``D_wl`` in m)."""
     return 4.70e-3 * (1.0 - math.exp(-D_wl / 7.78e-3))
+
+
+def layer_columns(x0, normal_axis: int = 1, resolution: float = 1e-9) -> tuple[np.ndarray, int]:
+    """Lattice column of each weak-layer particle, for the column mean of ``kappa``.
+
+    Particles seeded at the same bed position (the coordinates other than
+    ``normal_axis`` of their initial positions ``x0``, m, equal to within
+    ``resolution`` m) share a column: the particles across the layer thickness
+    at one bed position (:func:`mpm_warp.kernels.bonded_camclay.kappa_column_sum_kernel`).
+
+    Returns
+    -------
+    column : numpy.ndarray of int32, shape (n,)
+        Column index of each particle, in ``[0, n_columns)``.
+    n_columns : int
+    """
+    x0 = np.asarray(x0, dtype=np.float64)
+    if x0.ndim != 2 or x0.shape[1] != 3 or not np.all(np.isfinite(x0)):
+        raise InvalidArgument("x0", f"array of shape {x0.shape}", "finite positions of shape (n, 3)")
+    bed = np.delete(x0, normal_axis, axis=1)
+    _, column = np.unique(np.round(bed / resolution), axis=0, return_inverse=True)
+    column = column.reshape(-1).astype(np.int32)
+    return column, int(column.max()) + 1 if len(column) else 0
 
 
 def critical_cut_length(tau_p: float, slab_E: float, slab_nu: float, slab_density: float, D_wl: float,

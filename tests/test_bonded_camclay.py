@@ -25,6 +25,7 @@ import pytest
 import warp as wp
 
 from mpm_warp.bonded_point import drive_bonded, total_path
+from mpm_warp.errors import InvalidArgument
 from mpm_warp.kernels.bonded_camclay import (
     bonded_camclay_return_func,
     bonded_p0_func,
@@ -36,6 +37,8 @@ from mpm_warp.kernels.camclay import SINGULAR_VALUE_FLOOR, camclay_pq_func
 from mpm_warp.kernels.types import vec3
 from mpm_warp.material_point import drive_material_points, lame_parameters, strain_path
 from mpm_warp.materials import BondedCamClay
+from mpm_warp.model import seed_block
+from mpm_warp.weak_layer import layer_columns
 
 DEVICE = "cpu"
 TYPES = {"float32": (wp.float32, np.float32, 2.0**-24), "float64": (wp.float64, np.float64, 2.0**-53)}
@@ -370,8 +373,12 @@ def test_objectivity_through_driver(dtype, tol):
 CYCLE = dict(E=1e6, nu=0.3, M=1.0, beta=0.3, xi=5.0, p0_ini=4086.0)  # the issue's case (p alternates 1013/3.5 Pa)
 
 
-def _isochoric_critical_state(E, nu, beta_e, xi, p0_ini):
-    """Closed form: isochoric simple shear ends at the apex, p = K (L - L0) = p0(L) (1 - beta_e) / 2."""
+def _isochoric_critical_state(E, nu, beta_e, xi, p0_ini, with_state=False):
+    """Closed form: isochoric simple shear ends at the apex, p = K (L - L0) = p0(L) (1 - beta_e) / 2 (Pa).
+
+    The total volume is fixed, so ``tr(eps_E) = -(L - L0)`` and ``p = K (L - L0)``; at the
+    apex the flow is deviatoric and ``L`` stops. Bisection for ``L`` in ``(L0, 0)``.
+    """
     _, _, K = lame_parameters(E, nu)
     L0 = -math.asinh(p0_ini / K) / xi
     lo, hi = L0, 0.0
@@ -381,17 +388,23 @@ def _isochoric_critical_state(E, nu, beta_e, xi, p0_ini):
             hi = m
         else:
             lo = m
-    return K * (lo - L0)
+    return (K * (lo - L0), lo) if with_state else K * (lo - L0)
 
 
 def test_issue_case_explicit_camclay_cycles():
-    """The case is hard: (1 - beta)/2 xi cosh(xi x) = 1.75 > 1 and camclay's explicit hardening cycles."""
+    """The case is hard: camclay's explicit hardening cycles between two states at dgamma = 0.02.
+
+    The fixed-point map of the explicit update has the slope -(1 - beta)/2 xi cosh(xi x)
+    at the critical state (x = -log_Jp there): 1.75 > 1, hence period 2 (issue 10).
+    """
     H = np.zeros((3, 3))
     H[0, 1] = 0.4
     r = drive_material_points(strain_path(H, 20), dtype="float64", **CYCLE)
     p = r["p"][0, -4:]
+    print("camclay, dgamma = 0.02: p alternates", p[-2:])
     assert abs(p[0] - p[2]) < 1e-6 * p[0] and abs(p[0] - p[1]) > 0.5 * max(p[0], p[1])
-    assert 0.35 * CYCLE["xi"] * math.cosh(0.0) > 1.0
+    _, L = _isochoric_critical_state(CYCLE["E"], CYCLE["nu"], CYCLE["beta"], CYCLE["xi"], CYCLE["p0_ini"], True)
+    assert (1 - CYCLE["beta"]) / 2 * CYCLE["xi"] * math.cosh(-CYCLE["xi"] * L) > 1.0
 
 
 @pytest.mark.parametrize("dtype", list(TYPES))
@@ -428,6 +441,18 @@ def test_no_cycling_converges_to_the_critical_state(dtype, dgamma):
 
 
 # ----------------------------------------------------------------------------- column averaging
+def test_layer_columns_of_a_seeded_layer():
+    """A layer seeded by the engine's lattice: one column per bed position, the particles across the layer."""
+    x0, _ = seed_block((0.0, 0.0, 0.0), (0.3, 0.02, 0.01), 0.005, 2)  # 4 cells across, 2 particles per cell
+    col, n_col = layer_columns(x0)
+    assert n_col == 120 * 4 and np.all(np.bincount(col) == 8)
+    for j in (0, 7, n_col - 1):
+        xs = x0[col == j]
+        assert np.ptp(xs[:, 0]) == 0 and np.ptp(xs[:, 2]) == 0 and np.ptp(xs[:, 1]) > 0.015
+    with pytest.raises(InvalidArgument):
+        layer_columns(np.zeros((3, 2)))
+
+
 @pytest.mark.parametrize("dtype", list(TYPES))
 def test_column_mean(dtype):
     T, nt, _ = TYPES[dtype]
