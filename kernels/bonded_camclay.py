@@ -216,11 +216,13 @@ def _volumetric_solve_func(T):
     """Implicit volumetric hardening at a fixed bond ``b``: root ``L`` of ``g`` (module docstring).
 
     Returns ``(L, p, q)`` with ``(p, q)`` the closest point on the surface of
-    ``(L, b)``. Newton from ``L_guess`` safeguarded by the bracket; stops when
-    the step is below ``2 eps (|L| + |d|)`` (``d`` the bracket width) or the
-    bracket collapses.
+    ``(L, b)``. Newton from ``L_guess`` kept in the bracket (bisection when a step
+    leaves it; doubling steps where ``g`` decreases); stops when ``|g|`` is at
+    its rounding level ``2 eps (1 + |L| + |L_n| + (|p| + |p_tr|)/K)``, or the
+    bracket or the step vanish.
     """
     project = _project_func(T)
+    p0_int = camclay_p0_func(T)
     eps = _eps(T)
     two_eps = 2.0 * eps
     x_cap = _X_CAP
@@ -228,21 +230,20 @@ def _volumetric_solve_func(T):
 
     @wp.func
     def p0_int_and_slope(L: T, K: T, xi: T, p0_floor: T):
+        """camclay's ``p0_int`` (Pa) and its slope ``d p0_int / d L`` (Pa; 0 at the floor and the cap)."""
+        p = p0_int(L, K, xi, p0_floor)
         x = xi * wp.max(-L, T(0.0))
-        if x >= T(x_cap):
-            return K * wp.sinh(T(x_cap)), T(0.0)
-        p = K * wp.sinh(x)
-        if p <= p0_floor or L >= T(0.0):
-            return p0_floor, T(0.0)
-        return p, -K * xi * wp.cosh(x)
+        slope = T(0.0)
+        if x < T(x_cap) and K * wp.sinh(x) > p0_floor:
+            slope = -K * xi * wp.cosh(x)
+        return p, slope
 
     @wp.func
     def volumetric_solve(p_tr: T, q_tr: T, L_n: T, L_guess: T, b: T, K: T, mu: T, M: T, beta: T, xi: T,
                          p0_floor: T, p_bond: T):
         beta_e = beta * b
         bp = b * p_bond
-        p0n, s0 = p0_int_and_slope(L_n, K, xi, p0_floor)
-        d = (T(0.5) * (p0n + bp) * (T(1.0) - beta_e) - p_tr) / K
+        d = (T(0.5) * (p0_int(L_n, K, xi, p0_floor) + bp) * (T(1.0) - beta_e) - p_tr) / K
         lo = L_n + wp.min(d, T(0.0))
         hi = L_n + wp.max(d, T(0.0))
         x = wp.min(wp.max(L_guess, lo), hi)
