@@ -22,6 +22,8 @@ is the volume ratio to the initial state.
 """
 
 import functools
+import math
+from dataclasses import replace
 
 import numpy as np
 import warp as wp
@@ -180,7 +182,7 @@ def drive_bonded(material: BondedCamClay, F_path, sigma_yy=None, *, kappa_ini: f
     Parameters
     ----------
     material : BondedCamClay
-        The weak-layer material (validated here). ``kappa_s`` may be ``inf`` (bond kept).
+        The weak-layer material (validated here); ``kappa_s`` may also be ``inf`` (the bond kept).
     F_path : array_like, shape (n_points, n_increments, 3, 3) or (n_increments, 3, 3)
         Total deformation gradient after each increment (dimensionless); its
         ``[1, 1]`` entry is only the starting guess where ``sigma_yy`` is given.
@@ -200,8 +202,8 @@ def drive_bonded(material: BondedCamClay, F_path, sigma_yy=None, *, kappa_ini: f
     """
     if not isinstance(material, BondedCamClay):
         raise InvalidArgument("material", material, "a BondedCamClay")
-    if not (np.isinf(material.kappa_s) and material.kappa_s > 0):
-        material.validate("material")
+    kept = material.kappa_s == math.inf  # a bond that never breaks: allowed here (tests of the return)
+    (replace(material, kappa_s=1.0) if kept else material).validate("material")
     if not (np.isfinite(kappa_ini) and kappa_ini >= 0):
         raise InvalidArgument("kappa_ini", kappa_ini, "a finite number >= 0")
     if dtype not in _DTYPES:

@@ -48,9 +48,12 @@ Conversions:
 
 Derived predictions for the scenes: the compressive (oedometric) strength, the
 collapse law at any final pressure, the residual strength and the bond left at
-the collapse, and the critical cut length on flat ground (Gaume et al. 2017)
+the collapse, the critical cut length on flat ground (Gaume et al. 2017)
 ``a_c = sqrt(2 tau_p E' D_wl / (G_wl rho g))``, ``E' = E_slab / (1 - nu_slab^2)``,
-``G_wl`` the layer's shear modulus, ``rho`` the slab density.
+``G_wl`` the layer's shear modulus, ``rho`` the slab density, and Heierli's
+(2005) anticrack speed and touchdown distance with the collapse height ``h_c``
+(:func:`heierli_anticrack`; field PSTs: 20-30 m/s and about 2.7 m touchdown,
+Bergfeld et al. 2021).
 """
 
 import math
@@ -73,8 +76,8 @@ from .weak_layer_paths import (
     xi_for_collapse,
 )
 
-__all__ = ["WeakLayer", "weak_layer_material", "weac_collapse_height", "critical_cut_length", "layer_columns",
-           "CALIBRATION_RTOL"]
+__all__ = ["WeakLayer", "weak_layer_material", "weac_collapse_height", "critical_cut_length", "heierli_anticrack",
+           "layer_columns", "CALIBRATION_RTOL"]
 
 CALIBRATION_RTOL = 1e-3
 """Relative tolerance of the ``kappa_s`` calibration on ``w_f`` or ``delta_s``."""
@@ -121,6 +124,19 @@ def critical_cut_length(tau_p: float, slab_E: float, slab_nu: float, slab_densit
     return math.sqrt(2.0 * tau_p * E_prime * D_wl / (G_wl * slab_density * G))
 
 
+def heierli_anticrack(slab_E: float, slab_thickness: float, slab_density: float, h_c: float) -> tuple[float, float]:
+    """Heierli (2005) steady anticrack in an elastic slab on a collapsing layer: ``(speed, touchdown)`` (m/s, m).
+
+    ``c = (g D_f / (2 h_c rho h))^(1/4)``, ``l = 2.331 (2 h_c D_f / (g rho h))^(1/4)``,
+    ``D_f = E h^3 / 12`` (MODEL.md 6): ``E`` (Pa), ``h`` (m), ``rho`` (kg/m^3) of the
+    slab, ``h_c`` the collapse height (m). Example of MODEL.md 6: 5 MPa, 0.5 m,
+    200 kg/m^3, 2 mm give 33.6 m/s and 1.58 m.
+    """
+    D_f = slab_E * slab_thickness**3 / 12.0
+    return ((G * D_f / (2.0 * h_c * slab_density * slab_thickness)) ** 0.25,
+            2.331 * (2.0 * h_c * D_f / (G * slab_density * slab_thickness)) ** 0.25)
+
+
 @dataclass(frozen=True)
 class WeakLayer:
     """A calibrated weak layer: the material, what was given, what was derived and predicted.
@@ -146,6 +162,9 @@ class WeakLayer:
     critical_cut : float or None
         Gaume et al. (2017) ``a_c`` (m), when the slab's ``E``, ``nu`` and density are known.
     critical_cut_inputs : dict
+    heierli_speed, heierli_touchdown : float or None
+        Heierli (2005) anticrack speed (m/s) and touchdown distance (m) with this ``h_c``,
+        when the slab's ``E``, thickness and density are known.
     calibration : dict
         ``runs``, ``n_increments``, ``relative_error`` of the ``kappa_s`` iteration.
     """
@@ -168,6 +187,8 @@ class WeakLayer:
     compressive_strength: float
     critical_cut: float | None
     critical_cut_inputs: dict = field(default_factory=dict)
+    heierli_speed: float | None = None
+    heierli_touchdown: float | None = None
     calibration: dict = field(default_factory=dict)
 
     def collapse_law(self, p0_int):
@@ -184,6 +205,8 @@ class WeakLayer:
         """Human-readable summary: inputs, derived parameters, predictions (printed by the scenes)."""
         m = self.material
         src = {k: "given" for k in self.given}
+        if "h_c" not in self.given and "xi" not in self.given:
+            src["h_c"] = "WEAC fit of D_wl"
         lines = [
             f"weak layer D_wl = {self.D_wl * 1e3:.3g} mm under sigma_n = {self.sigma_n:.4g} Pa"
             + (f" (bed-parallel {self.tau_slope:.4g} Pa)" if self.tau_slope else ""),
@@ -202,6 +225,9 @@ class WeakLayer:
         ]
         if self.critical_cut is not None:
             lines.append(f"  critical cut (Gaume et al. 2017, flat) a_c = {self.critical_cut:.3g} m")
+        if self.heierli_speed is not None:
+            lines.append(f"  anticrack (Heierli 2005, this h_c): speed {self.heierli_speed:.3g} m/s, touchdown "
+                         f"{self.heierli_touchdown:.3g} m")
         lines.append(f"  calibration: {self.calibration.get('runs')} shear-test runs, relative error "
                      f"{self.calibration.get('relative_error', 0.0):.1e}")
         return "\n".join(lines)
@@ -258,7 +284,9 @@ def weak_layer_material(*, E: float, nu: float, density: float, D_wl: float, M: 
     p0_floor_ratio : float
         Floor of ``p0_int`` relative to K (-).
     slab_E, slab_nu : float, optional
-        Slab elasticity (Pa, -), for the critical cut length only.
+        Slab elasticity (Pa, -), for the predictions only: the critical cut length
+        (needs ``slab_density``) and Heierli's anticrack (needs ``slab_density`` and
+        ``slab_thickness``).
 
     Returns
     -------
@@ -365,15 +393,21 @@ def weak_layer_material(*, E: float, nu: float, density: float, D_wl: float, M: 
         (x0, e0), (x1, e1) = hist[-2] if len(hist) > 1 else hist[-1], hist[-1]
         k = math.exp(x1 - e1 * (x1 - x0) / (e1 - e0)) if e1 != e0 else k * target / r[key]
     h_c_out = oedometric_collapse(mat, sigma_n) * D_wl
-    cut, cut_in = None, {}
-    if slab_E is not None and slab_nu is not None and slab_density is not None:
-        G_wl = mat.mu
-        cut_in = {"tau_p": tau_first, "slab_E": slab_E, "slab_nu": slab_nu, "slab_density": slab_density,
-                  "D_wl": D_wl, "G_wl": G_wl}
-        cut = critical_cut_length(**cut_in)
+    cut, cut_in, speed, touchdown = None, {}, None, None
+    if slab_E is not None and slab_density is not None:
+        f("slab_E", slab_E, lo=0.0, lo_open=True)
+        f("slab_density", slab_density, lo=0.0, lo_open=True)
+        if slab_nu is not None:
+            cut_in = {"tau_p": tau_first, "slab_E": slab_E, "slab_nu": f("slab_nu", slab_nu, lo=0.0, hi=0.5,
+                                                                        hi_open=True),
+                      "slab_density": slab_density, "D_wl": D_wl, "G_wl": mat.mu}
+            cut = critical_cut_length(**cut_in)
+        if slab_thickness is not None:
+            speed, touchdown = heierli_anticrack(slab_E, f("slab_thickness", slab_thickness, lo=0.0, lo_open=True),
+                                                 slab_density, h_c_out)
     return WeakLayer(
         material=mat, D_wl=D_wl, sigma_n=sigma_n, tau_slope=tau_slope, given=given, tau_p=tau_first,
         w_f=r["w_f"], delta_s=r["delta_s"], h_c=h_c_out, p_bond=p_bond, kappa_s=k, xi=xi, tau_peak=r["tau_peak"],
         tau_residual=r["tau_r"], bond_at_collapse=r["bond_before_loss"], compressive_strength=sigma_c,
-        critical_cut=cut, critical_cut_inputs=cut_in,
+        critical_cut=cut, critical_cut_inputs=cut_in, heierli_speed=speed, heierli_touchdown=touchdown,
         calibration={"runs": len(hist), "n_increments": n, "relative_error": math.expm1(abs(err)), "target": key})

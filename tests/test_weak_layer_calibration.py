@@ -37,7 +37,7 @@ from mpm_warp.bonded_point import drive_bonded, total_path
 from mpm_warp.errors import InvalidArgument, ScenarioError
 from mpm_warp.materials import BondedCamClay, material_from_dict
 from mpm_warp.validation.weak_layer import consolidation_pressure
-from mpm_warp.weak_layer import critical_cut_length, weac_collapse_height, weak_layer_material
+from mpm_warp.weak_layer import critical_cut_length, heierli_anticrack, weac_collapse_height, weak_layer_material
 from mpm_warp.weak_layer_paths import collapse_law, compressive_strength, loaded_shear_test, shear_strength
 
 wp.config.quiet = True
@@ -190,8 +190,11 @@ def test_derived_predictions_and_summary(layer):
     a_c = math.sqrt(2 * 1000.0 * 5e6 / (1 - 0.09) * 0.02 / (mat.mu * 250.0 * 9.81))
     assert abs(layer.critical_cut - a_c) < 1e-12 and 0.15 < a_c < 0.6
     assert critical_cut_length(**layer.critical_cut_inputs) == layer.critical_cut
+    c, l_td = heierli_anticrack(5e6, 0.5, 200.0, 2e-3)  # the example of MODEL.md 6: about 34 m/s and 1.6 m
+    assert abs(c - 33.6) < 0.05 and abs(l_td - 1.58) < 0.005
+    assert layer.heierli_speed == heierli_anticrack(5e6, 0.5, 250.0, layer.h_c)[0]
     text = str(layer)
-    for s in ("tau_p", "w_f", "delta_s", "h_c", "kappa_s", "xi", "p_bond", "a_c", "given", "predicted"):
+    for s in ("tau_p", "w_f", "delta_s", "h_c", "kappa_s", "xi", "p_bond", "a_c", "Heierli", "given", "predicted"):
         assert s in text
     assert layer.to_dict()["material"]["model"] == "bonded_camclay"
     slope = weak_layer_material(tau_p=1000.0, w_f=0.3, slope_angle=30.0, **LAYER)
@@ -226,6 +229,18 @@ def test_material_rejects_bad_parameters(field, value):
     with pytest.raises(InvalidArgument) as e:
         BondedCamClay(1e6, 0.3, 150.0, **{field: value}).validate("materials.wl")
     assert e.value.field == f"materials.wl.{field}"
+
+
+def test_driver_rejects_bad_input(layer):
+    with pytest.raises(InvalidArgument) as e:
+        drive_bonded(layer.material, np.zeros((2, 3)))
+    assert e.value.field == "F_path"
+    with pytest.raises(InvalidArgument) as e:
+        drive_bonded(layer.material, np.eye(3)[None], kappa_ini=-1.0)
+    assert e.value.field == "kappa_ini"
+    with pytest.raises(InvalidArgument) as e:
+        drive_bonded(BondedCamClay(1e6, 0.3, 150.0, beta=2.0, kappa_s=math.inf), np.eye(3)[None])
+    assert e.value.field == "material.beta"
 
 
 def test_material_from_dict():
