@@ -20,11 +20,15 @@ the accumulated plastic strain
     kappa += |eps_tr - eps_new| = sqrt(|dev d|^2 + tr(d)^2 / 3),   d = eps_tr - eps_new,
 
 the Euclidean norm of the principal plastic Hencky strain increment that the
-return gives (both parts count: bonds break in shear and in compaction, the
-"damage strain" of Rouainia and Muir Wood 2000 with equal weights). It is
-invariant (isotropic in the principal strains) and in plastic simple shear
-``gamma_p`` equals ``gamma_p / sqrt(2)``: a total plastic slip ``delta``
-across a layer of thickness ``D`` gives ``kappa = delta / (sqrt(2) D)``.
+return gives. Why this measure: both parts count, since bonds break in shear
+and in compaction (the "damage strain" of Rouainia and Muir Wood 2000, here
+with equal weights: no extra parameter); it is invariant (isotropic in the
+principal strains); and in plastic simple shear ``|d| = gamma_p / sqrt(2)``, so
+a plastic slip ``delta`` across a layer of thickness ``D`` gives ``kappa = delta
+/ (sqrt(2) D)``. The bond is linear in ``kappa`` (Rouainia and Muir Wood use an
+exponential decay) so that it ends at a finite slip, as the linear softening
+of a cohesive crack (Bazant and Oh 1983), and its fracture energy scales with
+``kappa_s``.
 
 Regularisation (crack band, Bazant and Oh 1983). ``kappa`` is meant to be the
 mean over the layer thickness at one bed position: after every step the
@@ -33,8 +37,10 @@ lattice column (:func:`kappa_column_sum_kernel`, :func:`kappa_column_mean_kernel
 The bond then lives on the layer's total plastic slip, ``b = 1 - delta /
 delta_s`` with ``delta_s = sqrt(2) D kappa_s``, however many cells span the
 layer and however the strain localises inside it, so the energy per unit
-crack area does not depend on dx (the band is the layer). ``kappa_s`` from a
-fracture energy or a softening displacement: :mod:`mpm_warp.weak_layer`.
+crack area does not depend on dx (the band is the layer). Within a step a
+particle's return sees its own increment; the mean comes after the step (a
+difference of the order of one step's increment). ``kappa_s`` from a fracture
+energy or a softening displacement: :mod:`mpm_warp.weak_layer`.
 
 Return mapping (MODEL.md 4, SI Note 1), fully implicit. The discrete flow rule
 ``eps_tr - eps_new = dgamma dy/dtau`` is solved with the surface of the *new*

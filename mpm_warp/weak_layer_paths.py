@@ -215,7 +215,9 @@ def loaded_shear_test(mat: BondedCamClay, sigma_n: float, D_wl: float, gamma_end
     ``tau_r``, ``delta_s`` (m), ``w_f`` (J/m^2), ``bond_before_loss`` (the bond of the
     last increment before ``b = 0``: the remaining bond that the collapse
     removed), ``max_bond_drop`` (largest drop of ``b`` in one increment before
-    that), ``lost`` (False if the bond survived ``gamma_end``).
+    that), ``lost`` (False if the bond survived ``gamma_end``), and the indices
+    into the curve of the first plastic increment (``first_yield_index``) and of
+    the first without bond (``loss_index``).
     """
     n = int(n_increments)
     if n < 2:
