@@ -296,8 +296,11 @@ def weak_layer_material(*, E: float, nu: float, density: float, D_wl: float, M: 
     ------
     InvalidArgument
         Naming the field: a value out of range, both or neither of a pair, a
-        strength the slab would already break (``tau_p`` too low for ``sigma_n`` or
-        below the intrinsic strength), a collapse the intrinsic consolidation forbids.
+        strength the slab would already break (``tau_p`` below the debonded
+        skeleton's, an oedometric strength below ``sigma_n``, or a first yield on
+        the compaction side of the critical state: the slab nearly crushes the
+        layer), a collapse the intrinsic consolidation forbids, a ``w_f`` or
+        ``delta_s`` the shear test cannot reach.
     """
     f = finite_number
     f("E", E, lo=0.0, lo_open=True)
