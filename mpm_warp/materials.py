@@ -195,6 +195,11 @@ class BondedCamClay(Elastic):
         """Consolidation pressure of the intact layer, ``max(p0_int_ini, p0_floor) + p_bond`` (Pa)."""
         return max(self.p0_int_ini, self.p0_floor) + self.p_bond
 
+    @property
+    def initial_kappa(self) -> float:
+        """``kappa(0) = 0``: the layer starts intact (a saw cut sets ``kappa >= kappa_s``)."""
+        return 0.0
+
 
 Material = Elastic | CamClaySnow | BondedCamClay
 MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow, "bonded_camclay": BondedCamClay}

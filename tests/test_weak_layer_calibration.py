@@ -248,5 +248,6 @@ def test_material_from_dict():
     m = material_from_dict({"model": "bonded_camclay", "E": 1e6, "nu": 0.3, "density": 150.0, "p_bond": 3e3,
                             "kappa_s": 0.02}, "materials.wl")
     assert isinstance(m, BondedCamClay) and m.plastic and m.p0_ini == pytest.approx(3e3 + 1e-5 * m.bulk)
+    assert m.initial_kappa == 0.0 and m.initial_log_jp == 0.0 and material_from_dict(m.to_dict()) == m
     with pytest.raises(ScenarioError, match="kappa_s"):
         material_from_dict({"model": "bonded_camclay", "E": 1e6, "nu": 0.3, "density": 150.0, "kapa_s": 0.02})
