@@ -1,4 +1,4 @@
-"""Constitutive models: elastic snow/ice and cohesive Cam-Clay snow (MODEL.md 1-3).
+"""Constitutive models: elastic snow/ice, cohesive Cam-Clay snow and the bonded weak layer (MODEL.md 1-3b).
 
 Materials are plain dataclasses; the engine turns them into kernel arguments.
 Every model uses St Venant-Kirchhoff elasticity in Hencky strain.
@@ -14,7 +14,7 @@ import numpy as np
 from .checks import finite_number
 from .kernels.camclay import initial_log_jp
 
-__all__ = ["Elastic", "CamClaySnow", "Material", "MATERIAL_MODELS", "lame_parameters",
+__all__ = ["Elastic", "CamClaySnow", "BondedCamClay", "Material", "MATERIAL_MODELS", "lame_parameters",
            "hardening_collapse"]
 
 
@@ -162,5 +162,81 @@ class CamClaySnow(Elastic):
         return hardening_collapse(p, self.bulk, self.xi, self.p0_ini)
 
 
-Material = Elastic | CamClaySnow
-MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow}
+@dataclass(frozen=True)
+class BondedCamClay(Elastic):
+    """Bonded (structured) Cam-Clay weak layer: strength lost over a set plastic strain, then collapse.
+
+    The yield ellipse of MODEL.md 2 with ``p0 = p0_int(log_Jp) + b p_bond`` and
+    cohesion ratio ``beta b``, ``b = max(0, 1 - kappa / kappa_s)`` the bond,
+    ``kappa`` the accumulated plastic strain (layer-column mean) and ``p0_int =
+    K sinh(xi max(-log_Jp, 0))`` the intrinsic hardening (MODEL.md 3b;
+    :mod:`mpm_warp.kernels.bonded_camclay`). Kernel state: ``(log_jp, kappa)``.
+    Build it from field measurements with :func:`mpm_warp.scenes.weak_layer.calibration.weak_layer_material`.
+
+    Parameters
+    ----------
+    E, nu, density : float
+        Elasticity as in :class:`Elastic`.
+    M : float
+        Slope of the critical state line (-), > 0.
+    beta : float
+        Cohesion ratio of the intact layer (-), in [0, 1]: tensile strength ``beta p0``.
+    xi : float
+        Intrinsic hardening factor (-), > 0.
+    p0_int_ini : float
+        Initial intrinsic consolidation pressure (Pa), >= 0 (0: a loose skeleton
+        that collapses once debonded); ``log_Jp(0) = -asinh(p0_int_ini / K) / xi``.
+    p0_floor_ratio : float
+        Floor of ``p0_int`` relative to K (-), in (0, 1e-2]; default 1e-5 (MODEL.md 3).
+    p_bond : float
+        Bonded part of the consolidation pressure of the intact layer (Pa), >= 0.
+    kappa_s : float
+        Accumulated plastic strain at which the bond is gone (-), > 0.
+    """
+
+    M: float = 1.2
+    beta: float = 0.3
+    xi: float = 0.01
+    p0_int_ini: float = 0.0
+    p0_floor_ratio: float = 1e-5
+    p_bond: float = 0.0
+    kappa_s: float = 0.01
+    model: str = field(default="bonded_camclay", init=False)
+    plastic = True
+
+    def validate(self, where: str = "material") -> BondedCamClay:
+        """Check every parameter; raise InvalidArgument naming ``where.field``."""
+        super().validate(where)
+        finite_number(f"{where}.M", self.M, lo=0.0, lo_open=True)
+        finite_number(f"{where}.beta", self.beta, lo=0.0, hi=1.0)
+        finite_number(f"{where}.xi", self.xi, lo=0.0, lo_open=True)
+        finite_number(f"{where}.p0_int_ini", self.p0_int_ini, lo=0.0)
+        finite_number(f"{where}.p0_floor_ratio", self.p0_floor_ratio, lo=0.0, hi=1e-2, lo_open=True)
+        finite_number(f"{where}.p_bond", self.p_bond, lo=0.0)
+        finite_number(f"{where}.kappa_s", self.kappa_s, lo=0.0, lo_open=True)
+        return self
+
+    @property
+    def p0_floor(self) -> float:
+        """Floor of the intrinsic consolidation pressure (Pa)."""
+        return self.p0_floor_ratio * self.bulk
+
+    @property
+    def initial_log_jp(self) -> float:
+        """``log_Jp(0) = -asinh(p0_int_ini / K) / xi`` (MODEL.md 3)."""
+        return initial_log_jp(self.p0_int_ini, self.bulk, self.xi)
+
+    @property
+    def p0_ini(self) -> float:
+        """Consolidation pressure of the intact layer, ``max(p0_int_ini, p0_floor) + p_bond`` (Pa)."""
+        return max(self.p0_int_ini, self.p0_floor) + self.p_bond
+
+    @property
+    def initial_kappa(self) -> float:
+        """``kappa(0) = 0``: the layer starts intact (a saw cut sets ``kappa >= kappa_s``)."""
+        return 0.0
+
+
+Material = Elastic | CamClaySnow | BondedCamClay
+MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow, "bonded_camclay": BondedCamClay}
+
