@@ -49,7 +49,7 @@ import sys
 import time
 
 from mpm_warp.errors import SimulationBlowUp
-from mpm_warp.simulation import versions
+from mpm_warp.result import versions
 from mpm_warp.validation import PROBLEMS, observed_order
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")

@@ -64,7 +64,7 @@ from test_weak_layer import (  # noqa: E402
 )
 
 import mpm_warp as mw  # noqa: E402
-from mpm_warp.simulation import versions  # noqa: E402
+from mpm_warp.result import versions  # noqa: E402
 
 RESULTS = os.path.join(HERE, "results")
 DEFAULT_CELLS = (2, 4, 8, 16, 32)  # cells across the weak layer: dx = D_wl / cells
@@ -139,7 +139,7 @@ def plot(data: dict, path: str) -> None:
                            p0_ini=mat["p0_ini"])
         ax.plot(W, oedometric_collapse(W, m), color=colors[xi], lw=1.5,
                 label=f"model, xi = {xi:g}" if xi == xis[0] else f"xi = {xi:g}")
-        ax.plot(W, hardening_collapse(W, m.p0_ini, m.bulk, xi), color=colors[xi], lw=0.8, ls=":")
+        ax.plot(W, hardening_collapse(W, m.bulk, xi, m.p0_ini), color=colors[xi], lw=0.8, ls=":")
         for r in (r for r in runs if r["xi"] == xi):
             ax.plot(r["W_mean"], r["collapse"], ls="none", marker=markers[r["cells"]], color=colors[xi], ms=6,
                     mfc="none")

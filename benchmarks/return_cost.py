@@ -41,8 +41,9 @@ import numpy as np
 import warp as wp
 
 from mpm_warp.kernels.camclay import camclay_p0_func, camclay_return_strain_func, camclay_yield_func
-from mpm_warp.kernels.constitutive import constitutive_update_func, material_struct, principal_strain_func, trial_func
+from mpm_warp.kernels.constitutive import constitutive_update_func, material_struct, trial_func
 from mpm_warp.kernels.logstrain import expm1_func, log1p_func, log_strain_func
+from mpm_warp.kernels.principal import principal_strain_func
 from mpm_warp.kernels.types import mat, vec
 from mpm_warp.model import material_params
 
@@ -66,9 +67,10 @@ def _kernels(T, dim):
     @wp.func
     def update_any(H_tr: M, hzz: T, lj: T, m: P):
         if wp.static(dim == 2):
-            return update(H_tr, hzz, lj, m)
+            H_new, hzz_new, tau, lj_new, kappa_new, flags = update(H_tr, hzz, lj, T(0.0), m)
+            return H_new, hzz_new, tau, lj_new, flags
         else:
-            H_new, tau, lj_new, flags = update(H_tr, lj, m)
+            H_new, tau, lj_new, kappa_new, flags = update(H_tr, lj, T(0.0), m)
             return H_new, hzz, tau, lj_new, flags
 
     @wp.func

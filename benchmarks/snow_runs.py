@@ -40,9 +40,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from common import RESULTS, environment, write_json  # noqa: E402
 
-from mpm_warp import fronts  # noqa: E402
-from mpm_warp.pst import run_pst  # noqa: E402
-from mpm_warp.shear_test import run_shear_test, shear_curves  # noqa: E402
+import mpm_warp as mw  # noqa: E402
+from mpm_warp.loader import load_scenario  # noqa: E402
+from mpm_warp.scenes.fronts import arrival_speed, critical_cut_length  # noqa: E402
+from mpm_warp.scenes.pst.references import critical_cut_length_formula, heierli_speed, heierli_touchdown  # noqa: E402
+from mpm_warp.scenes.shear_test import shear_curves, shear_summary  # noqa: E402
 
 FIELD_SPEED = (20.0, 30.0)  # m/s, PST crack speeds (Bergfeld et al. 2021; MODEL.md 6)
 FIELD_TOUCHDOWN = 2.7       # m, PST touchdown distance (Bergfeld et al. 2021)
@@ -68,22 +70,22 @@ def pst_case(name: str, scene: str, h5dir: str, device: str, overrides=None) -> 
     """Run one PST scene, write its JSON and figure, return the results."""
     path = os.path.join(h5dir, f"{name}.h5")
     t0 = time.perf_counter()
-    res, mon = run_pst(scene, output=path, device=device, overrides=overrides)
+    res = mw.run(scene, output=path, device=device, overrides=overrides)
+    mon = res.monitor
     elapsed = time.perf_counter() - t0
-    ex = dict(res.extra)
-    sc = mon.scene
-    d = sc["derived"]
-    slab = sc["slab"]
+    ex = dict(res.scene_result)
+    sc = mon.params
+    d = sc.references()
+    slab = sc.slab
     h_c = ex["collapse_height"]
     refs = {
         "field_speed_range": list(FIELD_SPEED),
-        "heierli_speed_measured_collapse": fronts.heierli_speed(slab["E"], sc["slab_thickness"], slab["density"], h_c),
+        "heierli_speed_measured_collapse": heierli_speed(slab.E, sc.slab_thickness, slab.density, h_c),
         "heierli_speed_law_collapse": d["heierli_speed"],
         "rayleigh_speed": d["rayleigh_speed"],
         "shear_wave_speed": d["shear_wave_speed"],
         "field_touchdown": FIELD_TOUCHDOWN,
-        "heierli_touchdown_measured_collapse": fronts.heierli_touchdown(slab["E"], sc["slab_thickness"],
-                                                                        slab["density"], h_c),
+        "heierli_touchdown_measured_collapse": heierli_touchdown(slab.E, sc.slab_thickness, slab.density, h_c),
         "heierli_touchdown_law_collapse": d["heierli_touchdown"],
         "collapse_height_law": d["collapse_height_law"],
     }
@@ -102,7 +104,7 @@ def pst_case(name: str, scene: str, h5dir: str, device: str, overrides=None) -> 
            "n_particles": res.n_particles, "steps": res.steps, "sim_time": res.sim_time,
            "stepping_wall_time_s": res.wall_time, "total_wall_time_s": elapsed,
            "particle_steps_per_s": res.particle_steps_per_s, "results": ex, "references": refs,
-           "relative_differences": cmp_, "scene_parameters": sc,
+           "relative_differences": cmp_, "scene_parameters": sc.to_dict(),
            "series": {"time": mon.times, "front": mon.series["front"], "failure_front": mon.series["failure_front"],
                       "collapse_height": mon.series["collapse_height"]},
            "arrival": {"s": sb.tolist(), "t": [float(v) if np.isfinite(v) else None for v in tb]}}
@@ -113,8 +115,7 @@ def pst_case(name: str, scene: str, h5dir: str, device: str, overrides=None) -> 
 
 def _pst_figure(name: str, mon, ex: dict, refs: dict) -> None:
     plt = _plt()
-    sc = mon.scene
-    d = sc["derived"]
+    sc = mon.params
     t = np.asarray(mon.times)
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     ax[0].plot(t, mon.series["front"], "k-", label="collapse front")
@@ -125,17 +126,16 @@ def _pst_figure(name: str, mon, ex: dict, refs: dict) -> None:
     ax[0].plot(tb[ok], sb[ok], ".", ms=2, color="0.5", label="bin arrival")
     lo, hi = ex["speed_fit_window"]
     if np.isfinite(ex["speed"]):
-        fit = fronts.arrival_speed(sb, tb, lo, hi)
+        fit = arrival_speed(sb, tb, lo, hi)
         ss = np.linspace(lo, hi, 10)
         ax[0].plot(fit.intercept + ss / fit.speed, ss, "g-", lw=3, alpha=0.5, label=f"fit {ex['speed']:.1f} m/s")
     ax[0].set(xlabel="t (s)", ylabel="distance from cut end (m)", title=f"{name}: crack front")
     ax[0].legend(fontsize=7)
     # slab-base deflection profiles
-    L = float(sc["length"])
-    mk = np.asarray(d["markers"])
-    s_mk = mk if sc["saw"]["from_end"] == "left" else L - mk
+    mk = sc.markers()
+    s_mk = sc.distance_from_cut_end(mk)
     uy = np.stack([np.asarray(mon.series[f"marker{k}_uy"]) for k in range(len(mk))], axis=1)
-    i0 = min(int(np.searchsorted(t, d["saw_start"])), len(t) - 1)
+    i0 = min(int(np.searchsorted(t, sc.saw_start)), len(t) - 1)
     w = -(uy - uy[i0]) * 1000.0
     front = np.asarray(mon.series["front"])
     for i in np.linspace(i0, len(t) - 1, 7).astype(int):
@@ -161,14 +161,16 @@ def shear_case(h5dir: str, device: str, overrides=None) -> dict:
     """Run the shear test, write its JSON and figure."""
     path = os.path.join(h5dir, "shear_test.h5")
     t0 = time.perf_counter()
-    res, mon = run_shear_test("shear_test", output=path, device=device, overrides=overrides)
+    res = mw.run("shear_test", output=path, device=device, overrides=overrides)
+    mon = res.monitor
     elapsed = time.perf_counter() - t0
     series = {k: np.asarray(v) for k, v in mon.series.items()}
-    c = shear_curves(mon.scene, mon.times, series)
+    c = shear_curves(mon.params, mon.times, series)
     n0 = len(mon.times) - len(c["u"])
     out = {"case": "shear_test", "environment": environment(res.device), "n_particles": res.n_particles,
            "steps": res.steps, "stepping_wall_time_s": res.wall_time, "total_wall_time_s": elapsed,
-           "scene_parameters": mon.scene, "curves": {k: np.asarray(v).tolist() for k, v in c.items()},
+           "scene_parameters": mon.params.to_dict(), "references": mon.params.references(),
+           "curves": {k: np.asarray(v).tolist() for k, v in c.items()},
            "failed_fraction": series["failed_fraction"][n0:].tolist(),
            "layer_shear_stress": series["layer_shear_stress"][n0:].tolist()}
     return shear_report(out)
@@ -177,8 +179,8 @@ def shear_case(h5dir: str, device: str, overrides=None) -> dict:
 def shear_report(out: dict) -> dict:
     """Results, comparisons, JSON and figure of a shear test from its stored curves (``out["curves"]``)."""
     c = {k: np.asarray(v, dtype=float) for k, v in out["curves"].items()}
-    sm = fronts.shear_summary(c["u"], c["tau"], c["axial"])
-    d = out["scene_parameters"]["derived"]
+    sm = shear_summary(c["u"], c["tau"], c["axial"])
+    d = out.get("references") or out["scene_parameters"]["derived"]  # files written before the scenes package
     ex = {"peak_shear_stress": sm.peak_stress, "residual_shear_stress": sm.residual_stress,
           "peak_displacement": sm.peak_displacement, "softening_displacement": sm.softening_displacement,
           "drop_displacement": sm.drop_displacement, "collapse_fraction": sm.collapse_fraction,
@@ -228,16 +230,16 @@ def critical_case(h5dir: str, device: str, tau_p: float | None, lo: float = 0.0,
         a = max(a, 1e-3)
         speed = 4.0
         end = 0.1 + a / speed + 0.12  # settle, cut, then time for the crack to cross the column
-        res, _ = run_pst("pst_demo", device=device,
-                         overrides=[f"scene.saw.cut_length={a}", f"time.end={end}"])
-        runs.append({"cut_length": a, "propagated": res.extra["propagated"], "front_final": res.extra["front_final"],
+        res = mw.run("pst_demo", device=device, overrides=[f"scene.saw.cut_length={a}", f"time.end={end}"])
+        ex = res.scene_result
+        runs.append({"cut_length": a, "propagated": ex["propagated"], "front_final": ex["front_final"],
                      "wall_time_s": res.wall_time})
-        print(f"  critical cut: a = {a:.3f} m -> propagated {res.extra['propagated']}", flush=True)
-        return bool(res.extra["propagated"])
+        print(f"  critical cut: a = {a:.3f} m -> propagated {ex['propagated']}", flush=True)
+        return bool(ex["propagated"])
 
     t0 = time.perf_counter()
     try:
-        b = fronts.critical_cut_length(propagates, lo, hi, tol)
+        b = critical_cut_length(propagates, lo, hi, tol)
         a_c, bracket = b.value, [b.lo, b.hi]
     except ValueError as e:
         a_c, bracket = math.nan, [lo, hi]
@@ -255,13 +257,9 @@ def gaume_formula(tau_p: float | None) -> float:
     """Gaume et al. (2017) flat-ground critical cut length (m) for pst_demo's layers and a shear strength (Pa)."""
     if not tau_p:
         return math.nan
-    from mpm_warp.scenario import load_scenario
-
     sc = load_scenario("pst_demo").scene
-    wl = sc["weak_layer"]
-    G = wl["E"] / (2.0 * (1.0 + wl["nu"]))
-    return fronts.critical_cut_length_formula(tau_p, sc["slab"]["E"], sc["slab"]["nu"], sc["weak_layer_thickness"],
-                                              G, sc["slab"]["density"])
+    G = sc.weak_layer.material(sc.sigma_n).mu
+    return critical_cut_length_formula(tau_p, sc.slab.E, sc.slab.nu, sc.weak_layer_thickness, G, sc.slab.density)
 
 
 def _refresh_critical_reference(summary: dict) -> None:
@@ -270,11 +268,9 @@ def _refresh_critical_reference(summary: dict) -> None:
     path = os.path.join(RESULTS, "snow_critical_cut.json")
     if not cc or not sh or not os.path.exists(path):
         return
-    from mpm_warp.scenario import load_scenario
-
     # same weak layer with p0_ini = 3 sigma_n: the strength scales with the slab load, so the shear
     # test's peak (pst_flat's slab) is scaled to pst_demo's slab
-    scale = load_scenario("pst_demo").scene["derived"]["sigma_n"] / sh["sigma_n"]
+    scale = load_scenario("pst_demo").scene.sigma_n / sh["sigma_n"]
     tau_p = sh["peak_shear_stress"] * scale
     formula = gaume_formula(tau_p)
     data = json.load(open(path))

@@ -1,8 +1,8 @@
 """Slope sweep on Dask: crack speed (or, until a PST scene ships, a proxy) against slope angle.
 
 With ``scenarios/pst_demo.toml`` present (or ``--scenario`` naming a PST scene) the sweep varies
-``scene.slope_angle`` and plots the PST crack speed (``RunResult.extra``: ``crack_speed`` if the
-scene reports it, else ``speed``, m/s) through :func:`mpm_warp.pst.run_pst`.
+``scene.slope_angle`` and plots the PST crack speed (``RunResult.scene_result``: ``crack_speed`` if the
+scene reports it, else ``speed``, m/s) through :func:`mpm_warp.run`.
 
 Proxy (used while no PST scene exists, or with ``--proxy``): the elastic_block scene (E 1 MPa,
 rho 250 kg/m^3, dx 2 cm, 2000 particles) set on the floor of a slope of angle theta, i.e. gravity
@@ -51,25 +51,16 @@ def slope_gravity(theta_deg: float) -> list[float]:
 
 
 def proxy_runner(scenario, output, device):
-    """Run the block and add its release speed and acceleration (m/s, m/s^2) to ``extra``."""
+    """Run the block and add its release speed and acceleration (m/s, m/s^2) to ``scene_result``."""
     res = mw.run(scenario, output, device)
     data = mw.read_run(output)
     vx = np.array([data.frame(i)["v"][:, 0].mean() for i in range(data.n_frames)], dtype=float)
     late = data.times >= data.times[-1] / 4
     theta = math.degrees(math.atan2(scenario.time.gravity[0], -scenario.time.gravity[1]))
     a_exact = max(0.0, G * (math.sin(math.radians(theta)) - MU * math.cos(math.radians(theta))))
-    res.extra.update(slide_speed=float(vx[-1]), slide_speed_exact=a_exact * float(data.times[-1]),
+    res.scene_result.update(slide_speed=float(vx[-1]), slide_speed_exact=a_exact * float(data.times[-1]),
                      acceleration=float(np.polyfit(data.times[late], vx[late], 1)[0]), acceleration_exact=a_exact)
     return res
-
-
-def pst_runner(scenario, output, device):
-    """PST scenes through :func:`mpm_warp.pst.run_pst` (saw and crack-front diagnostics)."""
-    if scenario.scene.get("kind") == "pst":
-        from mpm_warp import pst
-
-        return pst.run_pst(scenario, output, device)[0]
-    return mw.run(scenario, output, device)
 
 
 def figure(rows, x, y, exact, path, title):
@@ -105,7 +96,7 @@ def main(argv=None) -> int:
     slopes = [float(s) for s in split_values(a.slopes or ("0,10,20,30,35" if pst else "0,5,10,15,20,25,30,35,40"))]
     if pst:
         scenario, cases, fixed, x, runner = a.scenario, [{"scene.slope_angle": s} for s in slopes], a.set, \
-            "scene.slope_angle", pst_runner
+            "scene.slope_angle", None
     else:
         scenario, x, runner, fixed = "elastic_block", "scene.slope_deg", proxy_runner, PROXY_SET + a.set
         cases = [{"scene.slope_deg": s, "time.gravity": slope_gravity(s)} for s in slopes]
@@ -123,7 +114,7 @@ def main(argv=None) -> int:
     meta = {"scenario": scenario, "mode": "pst" if pst else "proxy", "x": x, "y": y, "overrides": fixed,
             "slopes_deg": slopes, "runs": len(res.rows), "failed": len(res.failed), "skipped": res.skipped,
             "sweep_wall_s": wall, "devices": sorted({str(r.get("device")) for r in res.rows}),
-            "workers": a.workers, "scheduler": a.scheduler or "LocalCluster", "versions": mw.simulation.versions()}
+            "workers": a.workers, "scheduler": a.scheduler or "LocalCluster", "versions": mw.result.versions()}
     with open(os.path.join(RESULTS, "sweep_slope.json"), "w") as fh:
         json.dump(meta, fh, indent=1)
     print(f"{'slope (deg)':>11} {y:>12}" + ("  exact (m/s)   a (m/s^2)  a exact" if not pst else "") + "  status")

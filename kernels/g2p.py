@@ -61,14 +61,14 @@ def g2p_kernel(dim, T):
                     g = grid_v[b[0] + a, b[1] + c]
                     dpos = (V(T(float(a)), T(float(c))) - fx) * dx
                     vn += w * g
-                    B += w * wp.outer(g, dpos)
+                    B += wp.outer(w * g, dpos)
                 else:
                     for d in range(3):
                         w = W[a, 0] * W[c, 1] * W[d, 2]
                         g = grid_v[b[0] + a, b[1] + c, b[2] + d]
                         dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
                         vn += w * g
-                        B += w * wp.outer(g, dpos)
+                        B += wp.outer(w * g, dpos)
         xn = x[i] + dt * vn
         clamped = 0
         for a in range(dim):

@@ -4,6 +4,9 @@ After Gaume, Gast, Teran, van Herwijnen and Jiang (2018), "Dynamic anticrack
 propagation in snow", Nature Communications 9:3047. MLS-MPM with quadratic
 B-splines, Hencky St Venant-Kirchhoff elasticity and cohesive Cam-Clay
 plasticity; runs on CUDA when present and on the CPU otherwise.
+
+The one way to run anything is :func:`run` (a scenario, a TOML file or a ready
+scene) and :func:`resume`; the layers are described in ``docs/architecture.md``.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ import os
 
 import warp as _wp
 
-__version__ = "0.1.0"
+from .version import __version__
 
 # Kernel compilation and cache messages are noise for users; MPM_WARP_VERBOSE=1 shows them.
 if not os.environ.get("MPM_WARP_VERBOSE"):
@@ -20,32 +23,20 @@ if not os.environ.get("MPM_WARP_VERBOSE"):
     if hasattr(_wp, "LOG_WARNING"):
         _wp.config.log_level = _wp.LOG_WARNING
 
-
-def scenarios_dir() -> str:
-    """Folder of the ready scenes (TOML files)."""
-    from importlib.resources import files
-
-    return str(files("mpm_warp.scenarios"))
-
-
+from .config import Block, Domain, Output, Scenario, TimeControl  # noqa: E402
 from .errors import InvalidArgument, MPMError, OutputError, ScenarioError, SimulationBlowUp  # noqa: E402
 from .io import RunData, read_run  # noqa: E402
-from .materials import CamClaySnow, Elastic  # noqa: E402
-from .scenario import Block, Domain, Output, Scenario, TimeControl, apply_overrides, load_scenario  # noqa: E402
-from .simulation import RunResult, Simulation, resume  # noqa: E402
+from .loader import apply_overrides, list_scenes, load_scenario, scenarios_dir  # noqa: E402
+from .materials import BondedCamClay, CamClaySnow, Elastic  # noqa: E402
+from .result import RunResult  # noqa: E402
+from .runner import resume, run  # noqa: E402
+from .simulation import Simulation  # noqa: E402
 from .walls import Wall, box_walls  # noqa: E402
 
-
-def run(scenario, output: str | None = None, device: str | None = None, overrides=None, **kwargs) -> RunResult:
-    """Load (if given a path or scene name) and run a scenario; return the :class:`RunResult`."""
-    if not isinstance(scenario, Scenario):
-        scenario = load_scenario(os.fspath(scenario), overrides)
-    return Simulation(scenario, device=device).run(output, **kwargs)
-
-
 __all__ = [
-    "Block", "CamClaySnow", "Domain", "Elastic", "InvalidArgument", "MPMError", "Output", "OutputError",
+    "Block", "BondedCamClay", "CamClaySnow", "Domain", "Elastic", "InvalidArgument", "MPMError", "Output",
+    "OutputError",
     "RunData", "RunResult", "Scenario", "ScenarioError", "Simulation", "SimulationBlowUp", "TimeControl",
-    "Wall", "apply_overrides", "box_walls", "load_scenario", "read_run", "resume", "run", "scenarios_dir",
-    "__version__",
+    "Wall", "apply_overrides", "box_walls", "list_scenes", "load_scenario", "read_run", "resume", "run",
+    "scenarios_dir", "__version__",
 ]

@@ -1,13 +1,17 @@
-"""Command line: ``mpm-warp run|resume|scenes|info ...``.
+"""Command line: ``mpm-warp run|resume|scenes|info|render|plot|sweep ...`` (every subcommand is here).
 
 Errors the library raises on purpose (bad input, blow-ups) are printed as one
 clear line with exit status 2 (input) or 3 (simulation), never a traceback.
+The commands call the library: :func:`mpm_warp.run`, :func:`mpm_warp.resume`,
+:func:`mpm_warp.post.render.render_run`, :func:`mpm_warp.post.plots.plot_run`,
+:func:`mpm_warp.sweep.run_sweep`.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import signal
 import sys
 import time
@@ -89,16 +93,16 @@ def _summary(res, out=sys.stdout):
         f"{res.device}; stepping {res.wall_time:.2f} s ({res.particle_steps_per_s / 1e6:.2f} M particle-steps/s)"
         + (f"; {res.edge_hits} particle clamps at the grid edge" if res.edge_hits else "")
         + (f"\noutput: {res.output}" if res.output else "") + "\n")
-    for k, v in res.extra.items():
+    for k, v in res.scene_result.items():
         out.write(f"  {k}: {v}\n")
 
 
 def cmd_run(a) -> int:
-    from .scenario import load_scenario
-    from .simulation import Simulation
+    from .loader import load_scenario
+    from .runner import simulation_for
 
     sc = load_scenario(a.scenario, a.set)
-    sim = Simulation(sc, device=a.device)
+    sim = simulation_for(sc, device=a.device)
     with StopRequest() as stop:
         prog = Progress(sc.time.end, stop=stop, quiet=a.quiet)
         try:
@@ -111,12 +115,12 @@ def cmd_run(a) -> int:
         print(f"mpm-warp: stopped at t = {res.sim_time:.6g} s on request{where}", file=sys.stderr)
         return 130
     if a.json:
-        print(json.dumps(res.__dict__, default=str))
+        print(json.dumps({k: v for k, v in res.__dict__.items() if k != "monitors"}, default=str))
     return 0
 
 
 def cmd_resume(a) -> int:
-    from .simulation import resume
+    from .runner import resume
 
     res = resume(a.run, device=a.device, end_time=a.end)
     _summary(res)
@@ -124,23 +128,112 @@ def cmd_resume(a) -> int:
 
 
 def cmd_scenes(a) -> int:
-    from .scenario import list_scenes, read_scenario_dict
+    from .loader import list_scenes, load_scenario
+    from .scenes import SCENES
 
     for name in list_scenes():
-        raw, _ = read_scenario_dict(name)
-        print(f"{name:20s} {raw.get('description', '')}")
+        print(f"{name:20s} {load_scenario(name).description}")
+    print("\nscene kinds ([scene] kind = ...):")
+    for kind, st in SCENES.items():
+        print(f"{kind:20s} {st.description}")
     return 0
 
 
 def cmd_info(a) -> int:
-    from .simulation import versions
+    from .result import versions
 
     print(json.dumps(versions(), indent=1))
     return 0
 
 
+def cmd_render(a) -> int:
+    from .post.render import render_run
+
+    out = render_run(a.run, field=a.field, frames=a.frames, out_dir=a.out, video=a.video or False,
+                     size=tuple(a.size), camera=a.camera, fps=a.fps)
+    print(f"{len(out.pngs)} frames of {out.field} [{out.unit}], colour range {out.clim[0]:.4g} .. "
+          f"{out.clim[1]:.4g}, in {os.path.dirname(out.pngs[0]) or '.'}")
+    if out.video:
+        print(f"film: {out.video}")
+    return 0
+
+
+def cmd_plot(a) -> int:
+    from .post.plots import plot_run
+
+    files = plot_run(a.run, a.out)
+    for f in files:
+        print(f)
+    if not files:
+        print("no plottable series in this run")
+    return 0
+
+
+def cmd_sweep(a) -> int:
+    """``mpm-warp sweep``: exit status 0 when every run is ok, 1 when some failed."""
+    from .sweep import parse_vary, run_sweep
+
+    res = run_sweep(a.scenario, parse_vary(a.vary), a.cases,
+                    a.out or f"sweep-{os.path.splitext(os.path.basename(a.scenario))[0]}", overrides=a.set,
+                    scheduler=a.scheduler, n_workers=a.workers, device=a.device, retries=a.retries,
+                    plot_x=a.plot_x, plot_y=a.plot_y, progress=not a.quiet)
+    for r in res.failed:
+        print(f"failed {r['id']}: {r['error']}", file=sys.stderr)
+    print(f"sweep: {len(res.rows)} runs, {len(res.rows) - len(res.failed)} ok ({res.skipped} from earlier "
+          f"sweeps), {len(res.failed)} failed\nsummary: {res.path}" + (f"\nfigure: {res.figure}" if res.figure else ""))
+    return 1 if res.failed else 0
+
+
+SWEEP_DESCRIPTION = (
+    "Run a parameter sweep: the cartesian product of the --vary lists, crossed with the rows of a --cases CSV "
+    "file, of scenario overrides (dotted keys as for --set: time.end, materials.snow.E, blocks.0.lo; a key of the "
+    "scene table may drop its 'scene.' prefix, e.g. slope_angle for scene.slope_angle). Each case is one run, "
+    "executed as a Dask task on a local cluster (one worker per GPU, else per CPU core) or on an existing one "
+    "(--scheduler). The runs, their JSON records, summary.csv and summary.png go to --out; running the same "
+    "sweep again skips the finished runs.")
+SWEEP_EXAMPLE = "example: mpm-warp sweep pst_demo --vary scene.slope_angle=0,10,20,30 --workers 2 --out sweep-slope"
+
+
+def _add_render(sub) -> None:
+    from .post.fields import FIELDS
+    from .post.render import CAMERAS
+
+    r = sub.add_parser("render", help="render a run's particles to PNG frames (and a film), off screen")
+    r.add_argument("run", help="HDF5 run file")
+    r.add_argument("--field", default="collapse", choices=sorted(FIELDS),
+                   help="colour: " + "; ".join(f"{f.name} [{f.unit}]" for f in FIELDS.values())
+                        + " (definitions and reference states: mpm_warp.post.fields)")
+    r.add_argument("--frames", default="all", help="'all' (default), indices '0,10,-1' or a slice '0:50:5'")
+    r.add_argument("--out", default=None, help="output folder (default: RUN_render beside the run)")
+    r.add_argument("--video", nargs="?", const="gif", default=None, choices=["gif", "mp4"],
+                   help="also make a film (default gif; mp4 needs ffmpeg)")
+    r.add_argument("--size", nargs=2, type=int, default=[1280, 720], metavar=("W", "H"), help="pixels")
+    r.add_argument("--camera", default="auto", choices=CAMERAS, help="side (PSTs), oblique, auto")
+    r.add_argument("--fps", type=float, default=10.0, help="film frames per second")
+    r.set_defaults(func=cmd_render)
+
+
+def _add_sweep(sub) -> None:
+    p = sub.add_parser("sweep", help="run a parameter sweep on a Dask cluster (one run per case)",
+                       description=SWEEP_DESCRIPTION, epilog=SWEEP_EXAMPLE)
+    p.add_argument("scenario", help="scenario file or ready scene name")
+    p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
+                   help="values of one override; the sweep is the cartesian product of every --vary")
+    p.add_argument("--cases", metavar="CSV", help="cases file: a header of override keys, one case per row")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override for every case")
+    p.add_argument("--out", help="folder of the runs and the summary (default sweep-SCENARIO)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--workers", type=int, help="workers of the local cluster (default: one per GPU, else core)")
+    p.add_argument("--device", help="cpu | cuda | cuda:N (default: each worker's GPU, else the CPU)")
+    p.add_argument("--retries", type=int, default=2, help="extra attempts of a run whose worker died")
+    p.add_argument("--plot-x", help="parameter on the figure's x axis (default: the first varied)")
+    p.add_argument("--plot-y", help="summary column on the y axis (default: the first numeric scene result)")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(func=cmd_sweep)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser (extended by the render, plot and sweep commands)."""
+    """The argument parser of every subcommand."""
     p = argparse.ArgumentParser(prog="mpm-warp", description="MPM in NVIDIA Warp for anticrack propagation in snow")
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -161,18 +254,16 @@ def build_parser() -> argparse.ArgumentParser:
     rs.add_argument("--end", type=float, default=None, help="new end time (s)")
     rs.set_defaults(func=cmd_resume)
 
-    sc = sub.add_parser("scenes", help="list the ready scenes")
+    sc = sub.add_parser("scenes", help="list the ready scenes and the scene kinds, one line each")
     sc.set_defaults(func=cmd_scenes)
     info = sub.add_parser("info", help="versions")
     info.set_defaults(func=cmd_info)
-
-    for mod in ("render", "plots", "sweep"):
-        try:
-            m = __import__(f"mpm_warp.{mod}", fromlist=["add_cli"])
-        except ImportError:
-            continue
-        if hasattr(m, "add_cli"):
-            m.add_cli(sub)
+    _add_render(sub)
+    pl = sub.add_parser("plot", help="plot a run's series (front speed, markers, shear test, energy)")
+    pl.add_argument("run", help="HDF5 run file")
+    pl.add_argument("--out", default=None, help="output folder (default: RUN_plots beside the run)")
+    pl.set_defaults(func=cmd_plot)
+    _add_sweep(sub)
     return p
 
 

@@ -1,4 +1,4 @@
-"""Constitutive models: elastic snow/ice and cohesive Cam-Clay snow (MODEL.md 1-3).
+"""Constitutive models: elastic snow/ice, cohesive Cam-Clay snow and the bonded weak layer (MODEL.md 1-3b).
 
 Materials are plain dataclasses; the engine turns them into kernel arguments.
 Every model uses St Venant-Kirchhoff elasticity in Hencky strain.
@@ -9,20 +9,40 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 
-from .validate import finite_number
+import numpy as np
 
-__all__ = ["Elastic", "CamClaySnow", "Material", "material_from_dict", "MATERIAL_MODELS", "lame_parameters"]
+from .checks import finite_number
+from .kernels.camclay import initial_log_jp
+
+__all__ = ["Elastic", "CamClaySnow", "BondedCamClay", "Material", "MATERIAL_MODELS", "lame_parameters",
+           "hardening_collapse"]
 
 
-def lame_parameters(E: float, nu: float) -> tuple[float, float, float]:
-    """Return ``(mu, lam, K)`` (Pa) from Young's modulus ``E`` (Pa) and Poisson's ratio ``nu`` (-).
+def lame_parameters(E, nu):
+    """Shear modulus, first Lame parameter and bulk modulus ``(mu, lam, K)`` (Pa) of ``E`` (Pa) and ``nu`` (-).
 
-    ``mu = E / (2 (1 + nu))``, ``lam = E nu / ((1 + nu)(1 - 2 nu))``,
-    ``K = lam + 2 mu / 3`` (MODEL.md section 1). The one home of these formulas.
+    ``mu = E / (2 (1 + nu))``, ``lam = E nu / ((1 + nu)(1 - 2 nu))``, ``K = lam + 2 mu / 3``
+    (MODEL.md 1). Floats or NumPy arrays; the one home of these formulas (a material's
+    :attr:`Elastic.mu`, :attr:`Elastic.lam` and :attr:`Elastic.bulk` call it).
     """
     mu = E / (2.0 * (1.0 + nu))
     lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     return mu, lam, lam + 2.0 * mu / 3.0
+
+
+def hardening_collapse(p, K: float, xi: float, p0_ini: float = 0.0):
+    """Plastic collapse ``1 - J_P / J_P,ini`` of Cam-Clay snow consolidated on the cap from ``p0_ini`` to ``p`` (-).
+
+    ``1 - exp(log_Jp(p) - log_Jp(p0_ini))`` with the hardening state of a consolidation
+    pressure, ``log_Jp(p0) = -asinh(p0 / K) / xi`` (:func:`mpm_warp.kernels.camclay.initial_log_jp`,
+    MODEL.md 3 and 6), i.e. ``1 - exp(-(asinh(p/K) - asinh(p0_ini/K)) / xi)``; zero where
+    ``p <= p0_ini`` (the cap does not move below its consolidation pressure). ``p``, ``p0_ini``
+    and ``K`` in Pa; ``p`` a float or an array.
+    """
+    log_jp = np.vectorize(initial_log_jp, otypes=[float])
+    c = 1.0 - np.exp(log_jp(p, K, xi) - initial_log_jp(p0_ini, K, xi))
+    c = np.where(np.asarray(p, dtype=float) > p0_ini, c, 0.0)
+    return float(c) if c.ndim == 0 else c
 
 
 @dataclass(frozen=True)
@@ -54,17 +74,17 @@ class Elastic:
 
     @property
     def mu(self) -> float:
-        """Shear modulus (Pa)."""
+        """Shear modulus (Pa), :func:`lame_parameters`."""
         return lame_parameters(self.E, self.nu)[0]
 
     @property
     def lam(self) -> float:
-        """First Lame parameter (Pa)."""
+        """First Lame parameter (Pa), :func:`lame_parameters`."""
         return lame_parameters(self.E, self.nu)[1]
 
     @property
     def bulk(self) -> float:
-        """Bulk modulus K = lam + 2 mu / 3 (Pa)."""
+        """Bulk modulus K = lam + 2 mu / 3 (Pa), :func:`lame_parameters`."""
         return lame_parameters(self.E, self.nu)[2]
 
     @property
@@ -133,32 +153,91 @@ class CamClaySnow(Elastic):
 
     @property
     def initial_log_jp(self) -> float:
-        """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (MODEL.md 3)."""
-        return -math.asinh(self.p0_ini / self.bulk) / self.xi
+        """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (MODEL.md 3; :func:`mpm_warp.kernels.camclay.initial_log_jp`)."""
+        return initial_log_jp(self.p0_ini, self.bulk, self.xi)
+
+    def collapse_at(self, p) -> float:
+        """Collapse ``1 - J_P / J_P,ini`` (-) consolidating from ``p0_ini`` to the pressure ``p`` (Pa),
+        :func:`hardening_collapse`."""
+        return hardening_collapse(p, self.bulk, self.xi, self.p0_ini)
 
 
-Material = Elastic | CamClaySnow
-MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow}
+@dataclass(frozen=True)
+class BondedCamClay(Elastic):
+    """Bonded (structured) Cam-Clay weak layer: strength lost over a set plastic strain, then collapse.
+
+    The yield ellipse of MODEL.md 2 with ``p0 = p0_int(log_Jp) + b p_bond`` and
+    cohesion ratio ``beta b``, ``b = max(0, 1 - kappa / kappa_s)`` the bond,
+    ``kappa`` the accumulated plastic strain (layer-column mean) and ``p0_int =
+    K sinh(xi max(-log_Jp, 0))`` the intrinsic hardening (MODEL.md 3b;
+    :mod:`mpm_warp.kernels.bonded_camclay`). Kernel state: ``(log_jp, kappa)``.
+    Build it from field measurements with :func:`mpm_warp.scenes.weak_layer.calibration.weak_layer_material`.
+
+    Parameters
+    ----------
+    E, nu, density : float
+        Elasticity as in :class:`Elastic`.
+    M : float
+        Slope of the critical state line (-), > 0.
+    beta : float
+        Cohesion ratio of the intact layer (-), in [0, 1]: tensile strength ``beta p0``.
+    xi : float
+        Intrinsic hardening factor (-), > 0.
+    p0_int_ini : float
+        Initial intrinsic consolidation pressure (Pa), >= 0 (0: a loose skeleton
+        that collapses once debonded); ``log_Jp(0) = -asinh(p0_int_ini / K) / xi``.
+    p0_floor_ratio : float
+        Floor of ``p0_int`` relative to K (-), in (0, 1e-2]; default 1e-5 (MODEL.md 3).
+    p_bond : float
+        Bonded part of the consolidation pressure of the intact layer (Pa), >= 0.
+    kappa_s : float
+        Accumulated plastic strain at which the bond is gone (-), > 0; ``inf`` keeps the bond.
+    """
+
+    M: float = 1.2
+    beta: float = 0.3
+    xi: float = 0.01
+    p0_int_ini: float = 0.0
+    p0_floor_ratio: float = 1e-5
+    p_bond: float = 0.0
+    kappa_s: float = 0.01
+    model: str = field(default="bonded_camclay", init=False)
+    plastic = True
+
+    def validate(self, where: str = "material") -> BondedCamClay:
+        """Check every parameter; raise InvalidArgument naming ``where.field``."""
+        super().validate(where)
+        finite_number(f"{where}.M", self.M, lo=0.0, lo_open=True)
+        finite_number(f"{where}.beta", self.beta, lo=0.0, hi=1.0)
+        finite_number(f"{where}.xi", self.xi, lo=0.0, lo_open=True)
+        finite_number(f"{where}.p0_int_ini", self.p0_int_ini, lo=0.0)
+        finite_number(f"{where}.p0_floor_ratio", self.p0_floor_ratio, lo=0.0, hi=1e-2, lo_open=True)
+        finite_number(f"{where}.p_bond", self.p_bond, lo=0.0)
+        if self.kappa_s != math.inf:  # inf: a bond that never breaks (structured Cam-Clay without destructuring)
+            finite_number(f"{where}.kappa_s", self.kappa_s, lo=0.0, lo_open=True)
+        return self
+
+    @property
+    def p0_floor(self) -> float:
+        """Floor of the intrinsic consolidation pressure (Pa)."""
+        return self.p0_floor_ratio * self.bulk
+
+    @property
+    def initial_log_jp(self) -> float:
+        """``log_Jp(0) = -asinh(p0_int_ini / K) / xi`` (MODEL.md 3)."""
+        return initial_log_jp(self.p0_int_ini, self.bulk, self.xi)
+
+    @property
+    def p0_ini(self) -> float:
+        """Consolidation pressure of the intact layer, ``max(p0_int_ini, p0_floor) + p_bond`` (Pa)."""
+        return max(self.p0_int_ini, self.p0_floor) + self.p_bond
+
+    @property
+    def initial_kappa(self) -> float:
+        """``kappa(0) = 0``: the layer starts intact (a saw cut sets ``kappa >= kappa_s``)."""
+        return 0.0
 
 
-def material_from_dict(d: dict, where: str = "material") -> Elastic:
-    """Build a material from a dict with a ``model`` key; unknown keys are errors."""
-    import difflib
+Material = Elastic | CamClaySnow | BondedCamClay
+MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow, "bonded_camclay": BondedCamClay}
 
-    from .errors import ScenarioError
-
-    d = dict(d)
-    model = d.pop("model", "elastic")
-    if not isinstance(model, str) or model not in MATERIAL_MODELS:
-        raise ScenarioError(f"{where}.model = {model!r} is unknown: expected one of {sorted(MATERIAL_MODELS)}")
-    cls = MATERIAL_MODELS[model]
-    names = [f for f in cls.__dataclass_fields__ if f != "model"]
-    for k in d:
-        if k not in names:
-            close = difflib.get_close_matches(k, names, n=1)
-            hint = f" (did you mean '{where}.{close[0]}'?)" if close else ""
-            raise ScenarioError(f"unknown key '{where}.{k}'{hint} for model {model!r}; allowed: {', '.join(names)}")
-    for k in ("E", "nu", "density"):
-        if k not in d:
-            raise ScenarioError(f"{where}.{k}: missing (required for model {model!r})")
-    return cls(**d).validate(where)

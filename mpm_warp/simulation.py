@@ -9,74 +9,26 @@ from __future__ import annotations
 
 import math
 import os
-import platform
 import time as _time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 import warp as wp
 
 from . import io
+from .config import OUTPUT_FIELDS, Scenario
 from .device import resolve_device
-from .errors import InvalidArgument, SimulationBlowUp
+from .errors import InvalidArgument, OutputError, SimulationBlowUp
 from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_kernel
-from .model import Model, State, material_params
-from .scenario import OUTPUT_FIELDS, Scenario
+from .model import Model, ParticleGroup, State, material_params
+from .monitor import GroupState, Monitor
+from .result import RunResult, versions
 from .step import Stepper
 
-__all__ = ["Simulation", "RunResult", "versions"]
+__all__ = ["Simulation"]
 
 #: a particle may not move more than this many cells in one step (health check)
 MAX_CELLS_PER_STEP = 1.0
-
-
-def versions() -> dict[str, str]:
-    """Versions of the library and its main dependencies."""
-    import h5py
-
-    from . import __version__
-
-    return {"mpm_warp": __version__, "warp": wp.config.version, "numpy": np.__version__, "h5py": h5py.__version__,
-            "python": platform.python_version()}
-
-
-@dataclass
-class RunResult:
-    """What a run returns.
-
-    Attributes
-    ----------
-    output : str or None
-        Path of the HDF5 file.
-    steps : int
-        Steps taken in this call.
-    frames : int
-        Frames written in this call.
-    sim_time : float
-        Simulated time reached (s).
-    wall_time : float
-        Wall-clock time of the stepping (s), compilation excluded.
-    particle_steps_per_s : float
-        ``n_particles * steps / wall_time``.
-    n_particles : int
-    device : str
-    edge_hits : int
-        Particle clamps at the grid edge (see ``kernels/g2p.py``).
-    extra : dict
-        Scene diagnostics (crack speed, errors against references, ...).
-    """
-
-    output: str | None
-    steps: int
-    frames: int
-    sim_time: float
-    wall_time: float
-    particle_steps_per_s: float
-    n_particles: int
-    device: str
-    edge_hits: int = 0
-    extra: dict = field(default_factory=dict)
 
 
 class Simulation:
@@ -95,6 +47,8 @@ class Simulation:
         or more; ``MPM_WARP_THREADS`` overrides). Results depend on the thread
         count at round-off level only (the order grid copies are summed in).
 
+    A snow scene's saw, push and diagnostics are its monitor, attached by :func:`mpm_warp.run`.
+
     Examples
     --------
     >>> sim = Simulation(load_scenario("elastic_block"))          # doctest: +SKIP
@@ -111,22 +65,49 @@ class Simulation:
         self.stepper = Stepper(self.model, self.state, use_graph, n_threads)
         self.frame_index = 0
         self.x0 = self.state.x.numpy().astype(np.float64)
-        #: functions ``f(sim) -> dict[str, float]`` evaluated at every frame and stored as scalar series
-        self.frame_diagnostics: list[Callable[[Simulation], dict]] = []
-        #: functions ``f(sim) -> dict`` evaluated when a run ends, merged into ``RunResult.extra``
-        self.result_hooks: list[Callable[[Simulation], dict]] = []
+        #: monitors by name (:meth:`add_monitor`)
+        self.monitors: dict[str, Monitor] = {}
         self._since_health = 0
         self._bad = wp.full(3, INT_MAX, dtype=wp.int32, device=self.device)
-        from .scenes import attach_scene
-
-        attach_scene(self)
         self._energy = wp.zeros(2, dtype=wp.float64, device=self.device)
+        self._no_log_jp = wp.zeros(0, dtype=self.model.T, device=self.device)  # elastic groups: no plastic volume
 
     # ----------------------------------------------------------------- public
     @property
     def time(self) -> float:
         """Simulated time (s)."""
         return float(self.state.clock.numpy()[0])
+
+    @property
+    def clock(self) -> wp.array:
+        """Device clock ``[t, dt, t_end, dt_last]`` (float64, s), read by device actions."""
+        return self.state.clock
+
+    def add_monitor(self, monitor: Monitor) -> Monitor:
+        """Attach a monitor (:mod:`mpm_warp.monitor`): its actions run every step from the next one on."""
+        if not isinstance(monitor, Monitor):
+            raise InvalidArgument("monitor", type(monitor).__name__, "an mpm_warp.monitor.Monitor")
+        if monitor.name in self.monitors:
+            raise InvalidArgument("monitor.name", monitor.name, f"a name not in use (used: {sorted(self.monitors)})")
+        self.monitors[monitor.name] = monitor
+        self.stepper.actions.extend(monitor.actions())
+        return monitor
+
+    def group(self, name: str) -> ParticleGroup:
+        """The particle group (range, material, mass) of the block named ``name``."""
+        for g in self.model.groups:
+            if g.name == name:
+                return g
+        raise InvalidArgument("group", name, "one of " + ", ".join(repr(g.name) for g in self.model.groups))
+
+    def group_state(self, name: str) -> GroupState:
+        """Array views of the state of group ``name`` (:class:`mpm_warp.monitor.GroupState`)."""
+        g, s = self.group(name), self.state
+        sl = slice(g.start, g.end)
+        psl = slice(g.plastic_start, g.plastic_start + g.count)
+        return GroupState(g.name, g.material, g.start, g.end, g.mass, g.vol0, s.x[sl], s.v[sl], s.C[sl], s.H[sl],
+                          s.hzz[sl] if s.hzz is not None else None, s.log_jp[psl] if g.plastic_start >= 0 else None,
+                          self.x0[sl], s.kappa[psl] if g.columns is not None else None)
 
     def energies(self) -> dict[str, float]:
         """Kinetic and elastic energy (J; J/m of depth in 2D) of the current state."""
@@ -155,8 +136,9 @@ class Simulation:
         for g in self.model.groups:
             sl = slice(g.start, g.end)
             hz = s.hzz[sl] if s.hzz is not None else None
+            ljp = s.log_jp[g.plastic_start:g.plastic_start + g.count] if g.plastic_start >= 0 else self._no_log_jp
             wp.launch(stress_kernel(self.model.dim, T), g.count,
-                      inputs=[s.H[sl], hz, material_params(g.material, T), int(cauchy), p[sl], q[sl],
+                      inputs=[s.H[sl], hz, ljp, material_params(g.material, T), int(cauchy), p[sl], q[sl],
                               sig[sl] if cauchy else None],
                       device=self.device)
         return p.numpy(), q.numpy(), sig.numpy() if cauchy else None
@@ -176,13 +158,14 @@ class Simulation:
             return s.elastic_deformation_gradient().astype(self.model.np_dtype)
         if name == "stress":
             return self.stresses(cauchy=True)[2]
-        if name == "log_jp":
+        if name in ("log_jp", "kappa"):
             out = np.zeros(n, dtype=self.model.np_dtype)
-            if s.log_jp is not None:
-                lj = s.log_jp.numpy()
+            arr = getattr(s, name)
+            if arr is not None:
+                a = arr.numpy()
                 for g in self.model.groups:
-                    if g.plastic_start >= 0:
-                        out[g.start:g.end] = lj[g.plastic_start:g.plastic_start + g.count]
+                    if g.plastic_start >= 0 and (name == "log_jp" or g.columns is not None):
+                        out[g.start:g.end] = a[g.plastic_start:g.plastic_start + g.count]
             return out
         if name in ("p", "q"):
             p, q = self.stress_invariants()
@@ -321,11 +304,11 @@ class Simulation:
             if writer is not None:
                 writer.close()
         n = self.model.n_particles
-        extra = {}
-        for hook in self.result_hooks:
-            extra.update(hook(self))
+        result = {}
+        for m in self.monitors.values():
+            result.update(m.result())
         return RunResult(output, steps_total, frames, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
-                         n, self.device, self.stepper.edge_count()[0] - edge0, extra)
+                         n, self.device, self.stepper.edge_count()[0] - edge0, result, dict(self.monitors))
 
     def _compile(self) -> None:
         """Load every kernel of the plan (compiling on first use) without stepping."""
@@ -340,14 +323,16 @@ class Simulation:
             shape = tuple(self.model.dim if c == "dim" else c for c in shape)
             dt = "uint8" if name == "yielded" else self.scenario.precision
             pf[name] = (shape, dt, unit)
+        for m in self.monitors.values():
+            for name, (shape, unit) in getattr(m, "particle_fields", dict)().items():
+                pf[name] = (shape, self.scenario.precision, unit)
         group_id = np.zeros(self.model.n_particles, dtype=np.uint8)
         for i, g in enumerate(self.model.groups):
             group_id[g.start:g.end] = i
         static = {"x0": (self.x0.astype(self.model.np_dtype), "m"), "group": (group_id, "1")}
         scalars = {"kinetic_energy": "J", "elastic_energy": "J"}
-        for f in self.frame_diagnostics:
-            for k, unit in getattr(f, "units", {}).items():
-                scalars[k] = unit
+        for m in self.monitors.values():
+            scalars.update(m.units())
         attrs = {
             "scenario": self.scenario.to_dict(),
             "versions": versions(),
@@ -364,6 +349,8 @@ class Simulation:
     def _write_frame(self, writer: io.RunWriter) -> None:
         t, _, steps = self.stepper.clock()
         parts = {name: self.particle_field(name) for name in self.scenario.output.fields}
+        for m in self.monitors.values():
+            parts.update({name: m.particle_field(name) for name in getattr(m, "particle_fields", dict)()})
         scalars = self.energies()
         scalars.update(self._frame_diagnostics())
         imp = self.stepper.take_wall_impulse()
@@ -376,38 +363,42 @@ class Simulation:
         writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
 
     def _frame_diagnostics(self) -> dict:
-        """Evaluate the scene's frame diagnostics (also without an output file: they may record series)."""
+        """The monitors' frame scalars (also without an output file: they may record series)."""
         out = {}
-        for f in self.frame_diagnostics:
-            out.update(f(self))
+        for m in self.monitors.values():
+            out.update(m.frame_scalars(self))
         return out
 
     def _checkpoint(self, path: str | None) -> None:
         if path is None:
             return
-        meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device}
+        meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device,
+                "monitors": sorted(self.monitors)}
         arrays = self.state.arrays()
         # the next step's speed bound, so resume is bit for bit; one number, so any thread count or device resumes
         arrays["vmax"] = np.asarray([self.stepper.vmax.numpy().max()])
+        for name, m in self.monitors.items():
+            arrays.update({f"monitors/{name}/{k}": np.asarray(a) for k, a in m.state().items()})
         io.write_checkpoint(path, arrays, meta)
 
+    def restore(self, output: str) -> None:
+        """Load the last checkpoint of the run file ``output``: state, step bound, monitors, frame count.
 
-def resume(output: str, device: str | None = None, end_time: float | None = None,
-           callback=None) -> RunResult:
-    """Continue the run stored in ``output`` from its last checkpoint.
-
-    The run file is truncated to the checkpoint's frame and extended; on the
-    CPU a resumed run matches an uninterrupted one bit for bit.
-    """
-    arrays, meta = io.read_checkpoint(io.checkpoint_path_for(output))
-    sc = Scenario.from_dict(meta["scenario"], source=output)
-    sim = Simulation(sc, device=device)
-    sim.state.load_arrays(arrays)
-    if "vmax" in arrays:
-        sim.stepper.vmax.fill_(float(np.max(arrays["vmax"])))
-    else:
-        sim.stepper.seed_vmax()
-    sim.frame_index = int(meta["frame_index"])
-    run = io.read_run(output)
-    sim.x0 = run.static["x0"].astype(np.float64)
-    return sim.run(output, end_time=end_time, callback=callback, append=True)
+        Attach the same monitors first (their state is restored into them); on the CPU the run then
+        continues bit for bit as if never stopped.
+        """
+        ckpt = io.checkpoint_path_for(output)
+        arrays, meta = io.read_checkpoint(ckpt)
+        if set(meta.get("monitors", [])) != set(self.monitors):
+            raise OutputError(f"{ckpt}: holds the state of the monitors {sorted(meta.get('monitors', []))}, "
+                              f"this simulation has {sorted(self.monitors)}")
+        self.state.load_arrays(arrays)
+        if "vmax" in arrays:
+            self.stepper.vmax.fill_(float(np.max(arrays["vmax"])))
+        else:
+            self.stepper.seed_vmax()
+        for name, m in self.monitors.items():
+            prefix = f"monitors/{name}/"
+            m.load_state({k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)})
+        self.frame_index = int(meta["frame_index"])
+        self.x0[...] = io.read_run(output).static["x0"]

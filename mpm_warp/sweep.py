@@ -2,9 +2,9 @@
 
 A sweep is the cartesian product of ``vary`` lists (``--vary KEY=V1,V2,...``), crossed with the
 rows of a ``cases`` CSV file if one is given, of scenario overrides: dotted keys as accepted by
-:func:`mpm_warp.scenario.apply_overrides` (``time.end``, ``materials.snow.E``, ``blocks.0.lo``);
+:func:`mpm_warp.loader.apply_overrides` (``time.end``, ``materials.snow.E``, ``blocks.0.lo``);
 a key whose first part is not a scenario section but a key of its ``[scene]`` table is read as
-``scene.KEY`` (``slope_deg`` -> ``scene.slope_deg``). Each case is one :func:`mpm_warp.run`,
+``scene.KEY`` (``slope_angle`` -> ``scene.slope_angle``). Each case is one :func:`mpm_warp.run`,
 executed as a Dask task: by default on an embedded ``LocalCluster`` (one worker process per GPU,
 or per CPU core on a machine without one, one thread each, ``MPM_WARP_THREADS=1``), or on an
 existing cluster given by its scheduler address (mpm_warp installed on its workers; one worker per
@@ -14,7 +14,7 @@ Files in ``out_dir`` (``ID = <scenario name>-<16 hex digits of the SHA-256 of th
 scenario>``, i.e. of the file's content with the case's overrides applied)::
 
     ID.h5        the run (see mpm_warp.io)        ID.ckpt.h5   its last checkpoint
-    ID.json      parameters, overrides, RunResult fields, extra, last-frame scalars, status, error
+    ID.json      parameters, overrides, RunResult fields, scene_result, last-frame scalars, status, error
     summary.csv  one row per case, in case order  summary.png  a result against a parameter
 
 Faults: a run that raises is caught inside its task and comes back as a record with status
@@ -36,7 +36,6 @@ import datetime
 import hashlib
 import itertools
 import json
-import math
 import os
 import re
 import sys
@@ -45,19 +44,14 @@ import traceback
 import uuid
 from dataclasses import dataclass
 
-import numpy as np
-
 from . import io
 from .errors import InvalidArgument, MPMError
-from .scenario import Scenario, _split, apply_overrides, read_scenario_dict
+from .loader import TOP_LEVEL_KEYS, apply_overrides, read_scenario_dict, scenario_from_dict, split_override
+from .sweep_summary import RESULT_FIELDS, jsonable, number, plot_summary, summary_row, write_summary
 
 __all__ = ["SweepResult", "run_sweep", "expand_cases", "read_cases", "parse_vary", "split_values",
-           "default_workers", "plot_summary", "add_cli"]
+           "default_workers", "plot_summary"]
 
-#: RunResult fields copied into each record and summary row
-RESULT_FIELDS = ("steps", "frames", "sim_time", "wall_time", "particle_steps_per_s", "n_particles", "device",
-                 "edge_hits")
-_SECTIONS = {"name", "description", "precision", "domain", "time", "materials", "blocks", "walls", "output", "scene"}
 
 
 @dataclass
@@ -138,7 +132,7 @@ def _parse(value):
 
 def _full_key(raw: dict, key: str) -> str:
     head = key.split(".")[0]
-    if head not in _SECTIONS and isinstance(raw.get("scene"), dict) and head in raw["scene"]:
+    if head not in TOP_LEVEL_KEYS and isinstance(raw.get("scene"), dict) and head in raw["scene"]:
         return "scene." + key
     return key
 
@@ -166,18 +160,14 @@ def _tasks(raw, source, cases, fixed, out_dir, device, runner) -> list[dict]:
 def _record(task: dict, status: str, error: str | None = None) -> dict:
     return {"id": task["id"], "status": status, "error": error, "params": task["params"],
             "overrides": [f"{k}={v}" for k, v in task["overrides"]], "scenario": task["source"],
-            "output": task["id"] + ".h5", "result": {}, "extra": {}, "final": {}, "n_frames": 0, "worker": None,
+            "output": task["id"] + ".h5", "result": {}, "scene_result": {}, "final": {}, "n_frames": 0, "worker": None,
             "finished": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
-
-
-def _jsonable(o):
-    return o.tolist() if isinstance(o, (np.generic, np.ndarray)) else str(o)
 
 
 def _write_json(path: str, obj: dict) -> None:
     tmp = f"{path}.{os.getpid()}.tmp"
     with open(tmp, "w") as fh:
-        json.dump(obj, fh, indent=1, default=_jsonable)
+        json.dump(obj, fh, indent=1, default=jsonable)
     os.replace(tmp, path)
 
 
@@ -210,15 +200,13 @@ def _run_case(task: dict) -> dict:
     try:
         from distributed import get_worker
 
-        from . import run
-        from .scenes import expand_scene
+        from .runner import run
 
         rec["worker"] = get_worker().address
-        raw = expand_scene(apply_overrides(task["raw"], dict(task["overrides"])), task["source"])
-        scenario = Scenario.from_dict(raw, source=task["source"])
-        res = (task["runner"] or run)(scenario, out + ".part.h5", _worker_device(task["device"]))
+        scenario = scenario_from_dict(apply_overrides(task["raw"], dict(task["overrides"])), task["source"])
+        res = (task["runner"] or run)(scenario, out + ".part.h5", device=_worker_device(task["device"]))
         data = io.read_run(out + ".part.h5")
-        rec.update(status="ok", result={k: getattr(res, k) for k in RESULT_FIELDS}, extra=dict(res.extra),
+        rec.update(status="ok", result={k: getattr(res, k) for k in RESULT_FIELDS}, scene_result=dict(res.scene_result),
                    final={k: float(v[-1]) for k, v in data.scalars.items() if len(v)}, n_frames=data.n_frames)
         if os.path.exists(io.checkpoint_path_for(out + ".part.h5")):
             os.replace(io.checkpoint_path_for(out + ".part.h5"), io.checkpoint_path_for(out + ".h5"))
@@ -312,7 +300,7 @@ def run_sweep(scenario, vary: dict | None = None, cases=None, out_dir="sweep", *
         Extra attempts of a task whose worker died (beyond ``distributed.scheduler.allowed-failures``).
     plot_x, plot_y : str, optional
         Figure axes: a parameter (default the first varied key) and a summary column (default the first
-        numeric ``extra`` diagnostic, else ``wall_time``).
+        numeric ``scene_result`` value, else ``wall_time``).
     summary_path, figure_path : str, optional
         Default ``out_dir/summary.csv`` and the same name with ``.png``.
     runner : callable, optional
@@ -328,7 +316,7 @@ def run_sweep(scenario, vary: dict | None = None, cases=None, out_dir="sweep", *
     if n_workers is not None and (not isinstance(n_workers, int) or n_workers < 1):
         raise InvalidArgument("n_workers", n_workers, "an integer >= 1")
     raw, source = read_scenario_dict(os.fspath(scenario))
-    pairs = overrides.items() if isinstance(overrides, dict) else [_split(o) for o in overrides or ()]
+    pairs = overrides.items() if isinstance(overrides, dict) else [split_override(o) for o in overrides or ()]
     fixed = [(_full_key(raw, k), _parse(v)) for k, v in pairs]
     case_list = expand_cases(vary, cases)
     os.makedirs(out_dir, exist_ok=True)
@@ -355,114 +343,11 @@ def run_sweep(scenario, vary: dict | None = None, cases=None, out_dir="sweep", *
                 if stream is not None:
                     stream.write("\n")
     params = list(dict.fromkeys(k for t in tasks for k in t["params"]))
-    rows = [_row(t, records[t["id"]]) for t in tasks]
+    rows = [summary_row(t["params"], records[t["id"]]) for t in tasks]
     path = summary_path or os.path.join(out_dir, "summary.csv")
-    _write_csv(path, rows, ["id", "status", *params])
-    extra = list(dict.fromkeys(k for t in tasks for k in records[t["id"]].get("extra", {})))
+    write_summary(path, rows, ["id", "status", *params])
+    scene_keys = list(dict.fromkeys(k for t in tasks for k in records[t["id"]].get("scene_result", {})))
     x = plot_x or (params[0] if params else "id")
-    y = plot_y or next((k for k in extra if any(_num(r.get(k)) is not None for r in rows)), "wall_time")
+    y = plot_y or next((k for k in scene_keys if any(number(r.get(k)) is not None for r in rows)), "wall_time")
     fig = plot_summary(rows, x, y, figure_path or os.path.splitext(path)[0] + ".png", params)
     return SweepResult(rows, path, fig, len(tasks) - len(todo))
-
-
-# ------------------------------------------------------------------------------ summary, figure
-def _row(task: dict, rec: dict) -> dict:
-    row = {"id": rec["id"], "status": rec["status"], **task["params"]}
-    for k, v in rec.get("extra", {}).items():
-        row[k] = v if v is None or isinstance(v, (int, float, str)) else json.dumps(v, default=_jsonable)
-    row.update({f"final_{k}": v for k, v in rec.get("final", {}).items()})
-    row.update({k: rec.get("result", {}).get(k) for k in RESULT_FIELDS})
-    row.update(elapsed_s=rec.get("elapsed_s"), worker=rec.get("worker"),
-               output=rec["output"] if rec["status"] == "ok" else None, error=rec.get("error"))
-    return row
-
-
-def _write_csv(path: str, rows: list, first: list) -> None:
-    cols = list(dict.fromkeys([*first, *(k for r in rows for k in r)]))
-    tmp = f"{path}.{os.getpid()}.tmp"
-    with open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, cols, restval="")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: "" if v is None else json.dumps(v) if isinstance(v, (list, dict)) else v
-                        for k, v in r.items()})
-    os.replace(tmp, path)
-
-
-def _num(v) -> float | None:
-    try:
-        f = math.nan if v is None or isinstance(v, bool) else float(v)
-    except (TypeError, ValueError):
-        return None
-    return f if math.isfinite(f) else None
-
-
-def plot_summary(rows: list, x: str, y: str, path: str, params=()) -> str | None:
-    """Plot column ``y`` against parameter ``x`` of the ok rows, one line per value of the other ``params``
-    (those not co-varied with ``x``).
-
-    Returns the PNG path, or None when no row has a numeric ``y``.
-    """
-    from matplotlib.figure import Figure
-
-    ok = [r for r in rows if r["status"] == "ok" and _num(r.get(y)) is not None]
-    if not ok:
-        return None
-    numeric = all(_num(r.get(x)) is not None for r in ok)
-    cats = list(dict.fromkeys(str(r.get(x)) for r in ok))
-    key = {k: [str(r.get(k)) for r in ok] for k in (*params, x)}
-    # one line per value of the other parameters, but for those that change with x (co-varied with it)
-    others = [k for k in params if k != x and len(set(zip(key[x], key[k], strict=True))) > len(set(key[x]))]
-    groups = {}
-    for i, r in enumerate(ok):
-        groups.setdefault(tuple((k, key[k][i]) for k in others), []).append(r)
-    fig = Figure(figsize=(6.4, 4.2), layout="constrained")
-    ax = fig.add_subplot()
-    for g, rs in groups.items():
-        pts = sorted((_num(r[x]) if numeric else cats.index(str(r.get(x))), _num(r[y])) for r in rs)
-        ax.plot(*zip(*pts, strict=True), "o-", label=", ".join(f"{k} = {v}" for k, v in g) or None)
-    if not numeric:
-        ax.set_xticks(range(len(cats)), cats, rotation=30, ha="right")
-    n_bad = len(rows) - len(ok)
-    ax.set(xlabel=x, ylabel=y, title=f"{y} against {x}" + (f" ({n_bad} run(s) not shown)" if n_bad else ""))
-    ax.grid(alpha=0.3)
-    if len(groups) > 1:
-        ax.legend(fontsize="small")
-    tmp = f"{path}.{os.getpid()}.tmp"
-    fig.savefig(tmp, format="png", dpi=120)
-    os.replace(tmp, path)
-    return path
-
-
-# ------------------------------------------------------------------------------------------ CLI
-def cmd_sweep(a) -> int:
-    """``mpm-warp sweep``: exit status 0 when every run is ok, 1 when some failed."""
-    res = run_sweep(a.scenario, parse_vary(a.vary), a.cases,
-                    a.out or f"sweep-{os.path.splitext(os.path.basename(a.scenario))[0]}", overrides=a.set,
-                    scheduler=a.scheduler, n_workers=a.workers, device=a.device, retries=a.retries,
-                    plot_x=a.plot_x, plot_y=a.plot_y, progress=not a.quiet)
-    for r in res.failed:
-        print(f"failed {r['id']}: {r['error']}", file=sys.stderr)
-    print(f"sweep: {len(res.rows)} runs, {len(res.rows) - len(res.failed)} ok ({res.skipped} from earlier "
-          f"sweeps), {len(res.failed)} failed\nsummary: {res.path}" + (f"\nfigure: {res.figure}" if res.figure else ""))
-    return 1 if res.failed else 0
-
-
-def add_cli(subparsers) -> None:
-    """Add the ``sweep`` subcommand to the ``mpm-warp`` parser."""
-    p = subparsers.add_parser("sweep", help="run a parameter sweep on a Dask cluster (one run per case)",
-                              description=__doc__.split("\n\n")[1])
-    p.add_argument("scenario", help="scenario file or ready scene name")
-    p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
-                   help="values of one override; the sweep is the cartesian product of every --vary")
-    p.add_argument("--cases", metavar="CSV", help="cases file: a header of override keys, one case per row")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override for every case")
-    p.add_argument("--out", help="folder of the runs and the summary (default sweep-SCENARIO)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, e.g. tcp://host:8786")
-    p.add_argument("--workers", type=int, help="workers of the local cluster (default: one per GPU, else core)")
-    p.add_argument("--device", help="cpu | cuda | cuda:N (default: each worker's GPU, else the CPU)")
-    p.add_argument("--retries", type=int, default=2, help="extra attempts of a run whose worker died")
-    p.add_argument("--plot-x", help="parameter on the figure's x axis (default: the first varied)")
-    p.add_argument("--plot-y", help="summary column on the y axis (default: the first numeric extra)")
-    p.add_argument("--quiet", action="store_true", help="no progress line")
-    p.set_defaults(func=cmd_sweep)

@@ -12,12 +12,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import Literal, get_args
 
-from .validate import choice, finite_number, vector
+from .checks import choice, finite_number, vector
 
-__all__ = ["Wall", "WALL_KINDS", "box_walls"]
+__all__ = ["Wall", "WallKind", "WALL_KINDS", "box_walls"]
 
-WALL_KINDS = ("sticky", "slip", "separate")
+WallKind = Literal["sticky", "slip", "separate"]
+#: the wall kinds, in the order of their kernel codes (0 sticky, 1 slip, 2 separate): the one list of them
+WALL_KINDS: tuple[str, ...] = get_args(WallKind)
 
 
 @dataclass(frozen=True)
@@ -44,7 +47,7 @@ class Wall:
 
     point: tuple
     normal: tuple
-    kind: str = "slip"
+    kind: WallKind = "slip"
     friction: float = 0.0
     velocity: tuple | None = None
     ramp_time: float = 0.0
@@ -78,7 +81,7 @@ class Wall:
         return d
 
 
-def box_walls(lo, hi, kind: str = "slip", friction: float = 0.0, faces: str = "xyz") -> list[Wall]:
+def box_walls(lo, hi, kind: WallKind = "slip", friction: float = 0.0, faces: str = "xyz") -> list[Wall]:
     """The faces of the box ``[lo, hi]`` (2 or 3 components) as walls with inward normals.
 
     ``faces`` selects the axes whose two faces are walls (e.g. ``"xz"``); axes

@@ -18,7 +18,6 @@ from mpm_warp.validation import (  # noqa: F401  (re-exported for the tests)
     bar_period,
     com_velocity,
     fixed_free_bar,
-    hencky_cauchy_stress,
     observed_order,
     zero_crossings,
 )

@@ -148,11 +148,7 @@ def test_missing_section_or_key(tmp_path, text, needles):
                  id="material"),
 ])
 def test_misspelt_key_names_dotted_key_and_suggests(tmp_path, text, wrong, right):
-    """An unknown key fails with its dotted name and a did-you-mean.
-
-    The [materials.*] case FAILS until fixed: ``material_from_dict`` names the
-    key but suggests nothing (and gives no file name).
-    """
+    """An unknown key fails with its dotted name and a did-you-mean (also in a material's table)."""
     err = _expect(tmp_path, text, mw.ScenarioError, wrong)
     assert f"did you mean '{right}'" in str(err)
 

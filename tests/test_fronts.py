@@ -1,40 +1,45 @@
-"""Crack-front and shear-test diagnostics on synthetic data with known answers (mpm_warp.fronts)."""
+"""Crack-front and shear-test analyses on synthetic data with known answers (fronts, PST, shear test)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from mpm_warp import fronts
+from mpm_warp.materials import Elastic, hardening_collapse
+from mpm_warp.scenes import fronts
+from mpm_warp.scenes.pst import PSTParams, Saw, pst_summary, references
+from mpm_warp.scenes.pst.params import Front
+from mpm_warp.scenes.shear_test import shear_summary
+from mpm_warp.scenes.snow import Settle
 
 
 # ----------------------------------------------------------------------------- references
 def test_heierli_reproduces_model_example():
     # MODEL.md 6: E = 5 MPa, h = 0.5 m, h_f = 2 mm, rho = 200 gives about 34 m/s and 1.6 m
-    assert fronts.heierli_speed(5e6, 0.5, 200.0, 0.002) == pytest.approx(33.6, abs=0.5)
-    assert fronts.heierli_touchdown(5e6, 0.5, 200.0, 0.002) == pytest.approx(1.59, abs=0.05)
+    assert references.heierli_speed(5e6, 0.5, 200.0, 0.002) == pytest.approx(33.6, abs=0.5)
+    assert references.heierli_touchdown(5e6, 0.5, 200.0, 0.002) == pytest.approx(1.59, abs=0.05)
     # c^4 h_f = const and l^4 / h_f = const
-    c1, c2 = fronts.heierli_speed(5e6, 0.5, 200.0, 0.002), fronts.heierli_speed(5e6, 0.5, 200.0, 0.032)
+    c1, c2 = references.heierli_speed(5e6, 0.5, 200.0, 0.002), references.heierli_speed(5e6, 0.5, 200.0, 0.032)
     assert c1 / c2 == pytest.approx(2.0, rel=1e-12)
-    assert fronts.heierli_speed(5e6, 0.5, 200.0, 0.0) == math.inf
+    assert references.heierli_speed(5e6, 0.5, 200.0, 0.0) == math.inf
 
 
 def test_rayleigh_speed_model_example():
     # MODEL.md 7: E = 5 MPa, nu = 0.3, rho = 250: c_s 88, c_R 81 m/s
-    assert fronts.rayleigh_speed(5e6, 0.3, 250.0) == pytest.approx(81.2, abs=0.3)
+    assert Elastic(5e6, 0.3, 250.0).rayleigh_speed == pytest.approx(81.2, abs=0.3)
 
 
 def test_critical_cut_length_formula():
-    a = fronts.critical_cut_length_formula(500.0, 5e6, 0.3, 0.02, 2e5, 250.0)
+    a = references.critical_cut_length_formula(500.0, 5e6, 0.3, 0.02, 2e5, 250.0)
     assert a == pytest.approx(math.sqrt(2 * 500 * 5e6 / 0.91 * 0.02 / (2e5 * 250 * 9.81)), rel=1e-12)
 
 
 def test_hardening_collapse_law():
     K, xi = 8e5, 0.005
-    assert fronts.hardening_collapse(1000.0, K, xi) == pytest.approx(1 - math.exp(-math.asinh(1000 / K) / xi))
-    assert fronts.hardening_collapse(1000.0, K, xi, p0_ini=2000.0) == 0.0
+    assert hardening_collapse(1000.0, K, xi) == pytest.approx(1 - math.exp(-math.asinh(1000 / K) / xi))
+    assert hardening_collapse(1000.0, K, xi, p0_ini=2000.0) == 0.0
     # small p: 1 - J_P ~ p / (xi K)
-    assert fronts.hardening_collapse(1.0, K, xi) == pytest.approx(1.0 / (xi * K), rel=1e-3)
+    assert hardening_collapse(1.0, K, xi) == pytest.approx(1.0 / (xi * K), rel=1e-3)
 
 
 # ----------------------------------------------------------------------------- fronts
@@ -140,7 +145,7 @@ def test_shear_summary_on_synthetic_curve():
     tau = np.where(u < u_p, tau_p * u / u_p,
                    np.where(u < u_p + delta, tau_p - (tau_p - tau_r) * (u - u_p) / delta, tau_r))
     axial = 0.2 * np.clip((u - u_p) / delta, 0.0, 1.0)
-    sm = fronts.shear_summary(u, tau, axial)
+    sm = shear_summary(u, tau, axial)
     assert sm.peak_stress == pytest.approx(tau_p, rel=1e-3)
     assert sm.peak_displacement == pytest.approx(u_p, abs=1e-5)
     assert sm.residual_stress == pytest.approx(tau_r, rel=1e-9)
@@ -149,27 +154,27 @@ def test_shear_summary_on_synthetic_curve():
     assert sm.collapse_fraction == pytest.approx(0.2)
     # brittle drop below the residual, sliding at low stress, recovery to the residual (collapse)
     tau2 = np.where(u < u_p, tau_p * u / u_p, np.where(u < u_p + delta, 20.0, tau_r))
-    sm2 = fronts.shear_summary(u, tau2, axial)
+    sm2 = shear_summary(u, tau2, axial)
     assert sm2.drop_displacement == pytest.approx(u[1] - u[0], rel=1e-6)  # one sample after the peak
     assert sm2.softening_displacement == pytest.approx(delta, abs=2 * (u[1] - u[0]))
     # failure, collapse at a low stress, then a collapsed layer hardening above the intact peak
     tau3 = np.where(u < u_p, tau_p * u / u_p, np.where(u < u_p + delta, 20.0, 1.2 * tau_p))
-    sm3 = fronts.shear_summary(u, tau3, axial)
+    sm3 = shear_summary(u, tau3, axial)
     assert sm3.peak_stress == pytest.approx(tau_p, rel=0.02) and sm3.residual_stress == pytest.approx(1.2 * tau_p)
     assert sm3.softening_displacement == pytest.approx(delta, abs=2 * (u[1] - u[0]))
     # no softening: nan
-    assert math.isnan(fronts.shear_summary(u, tau_p * u / u[-1], axial).softening_displacement)
+    assert math.isnan(shear_summary(u, tau_p * u / u[-1], axial).softening_displacement)
 
 
 # ----------------------------------------------------------------------------- PST summary
 def _synthetic_pst(c=30.0, l_td=1.2, h=0.004, reverse=False):
-    """Scene dict, frame series and bin arrival times of an ideal PST (front at speed c from t0)."""
+    """Parameters, frame series and bin arrival times of an ideal PST (front at speed c from t0)."""
     L, cut, bw, t0 = 5.0, 0.4, 0.02, 0.2
-    markers = np.arange(0.05, L, 0.1)
-    scene = {"length": L, "saw": {"cut_length": cut, "from_end": "left"},
-             "derived": {"saw_start": 0.1, "saw_end": t0, "bin": bw, "markers": markers.tolist(),
-                         "heierli_speed": 1.0, "heierli_touchdown": 1.0, "rayleigh_speed": 1.0,
-                         "shear_wave_speed": 1.0, "collapse_height_law": h}}
+    # the saw runs from t = 0.1 s at 4 m/s: it stops at t0 = 0.2 s; markers every 0.1 m from 0.05 m
+    scene = PSTParams(length=L, dx=0.01, marker_spacing=0.1, settle=Settle(gravity_ramp=0.05, duration=0.1),
+                      saw=Saw(speed=4.0, cut_length=cut, from_end="left"), front=Front(bin=bw))
+    markers = scene.markers()
+    assert scene.saw_end == pytest.approx(t0) and markers[0] == pytest.approx(0.05)
     t = np.arange(0.0, 0.5, 0.002)
     sb = (np.arange(int(L / bw)) + 0.5) * bw
     if reverse:  # everything beyond the cut fails from the far end towards the saw
@@ -186,7 +191,7 @@ def _synthetic_pst(c=30.0, l_td=1.2, h=0.004, reverse=False):
 
 def test_pst_summary_on_ideal_front():
     scene, t, series, arrival = _synthetic_pst()
-    out = fronts.pst_summary(scene, t, series, arrival=arrival)
+    out = pst_summary(scene, t, series, arrival=arrival)
     assert out["speed"] == pytest.approx(30.0, rel=1e-6)
     assert out["speed_frames"] == pytest.approx(30.0, rel=0.05)
     assert out["propagated"] and out["ran_to_end"] and out["initiated_at_saw"]
@@ -197,7 +202,7 @@ def test_pst_summary_on_ideal_front():
 
 def test_pst_summary_flags_a_crack_started_elsewhere():
     scene, t, series, arrival = _synthetic_pst(c=150.0, reverse=True)
-    out = fronts.pst_summary(scene, t, series, arrival=arrival)
+    out = pst_summary(scene, t, series, arrival=arrival)
     assert not out["initiated_at_saw"]
     assert out["initiation_position"] > 4.5
     assert out["apparent_speed"] == pytest.approx(150.0, rel=1e-6)

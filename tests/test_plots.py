@@ -11,10 +11,10 @@ import pytest
 from PIL import Image
 
 import mpm_warp
-from mpm_warp import plots
 from mpm_warp.cli import main
 from mpm_warp.errors import InvalidArgument
 from mpm_warp.io import RunWriter, read_run
+from mpm_warp.post import fronts, plots
 
 T = np.linspace(0.0, 0.2, 41)                       # s, frames every 5 ms
 C, T0, CUT, END = 25.0, 0.05, 0.3, 3.0              # front speed [m/s], start [s], saw cut and column end [m]
@@ -58,7 +58,7 @@ def full_run(tmp_path_factory):
 
 
 def test_fit_front_speed_on_the_steady_part():
-    fit = plots.fit_front_speed(T, front_of(T))
+    fit = fronts.fit_front_speed(T, front_of(T))
     assert fit["speed"] == pytest.approx(C, rel=1e-9)
     assert fit["intercept"] == pytest.approx(CUT - C * T0, rel=1e-9)
     assert fit["r2"] == pytest.approx(1.0)
@@ -67,16 +67,16 @@ def test_fit_front_speed_on_the_steady_part():
     x_start, x_end = CUT + C * (fit["t_start"] - T0), CUT + C * (fit["t_end"] - T0)
     assert x_start >= CUT + 0.2 * (END - CUT) - 1e-9 and x_end <= CUT + 0.9 * (END - CUT) + 1e-9
     noisy = front_of(T) + 1e-3 * np.cos(37 * T)
-    assert plots.fit_front_speed(T, noisy)["speed"] == pytest.approx(C, rel=0.01)
+    assert fronts.fit_front_speed(T, noisy)["speed"] == pytest.approx(C, rel=0.01)
 
 
 def test_fit_front_speed_edge_cases():
-    assert np.isnan(plots.fit_front_speed(T, np.full_like(T, np.nan))["speed"])
-    assert np.isnan(plots.fit_front_speed(T, np.full_like(T, 0.5))["speed"])      # an arrested front
+    assert np.isnan(fronts.fit_front_speed(T, np.full_like(T, np.nan))["speed"])
+    assert np.isnan(fronts.fit_front_speed(T, np.full_like(T, 0.5))["speed"])      # an arrested front
     with pytest.raises(InvalidArgument):
-        plots.fit_front_speed(T, front_of(T), lo=0.9, hi=0.2)
+        fronts.fit_front_speed(T, front_of(T), lo=0.9, hi=0.2)
     with pytest.raises(InvalidArgument):
-        plots.fit_front_speed(T, front_of(T)[:-1])
+        fronts.fit_front_speed(T, front_of(T)[:-1])
 
 
 def test_plot_run_writes_every_figure_and_its_numbers(full_run, tmp_path):

@@ -7,12 +7,13 @@ import pytest
 import warp as wp
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
+import mpm_warp as mw
 from mpm_warp import read_run
-from mpm_warp.errors import ScenarioError
-from mpm_warp.kernels.snow import pst_action_kernel, weak_layer_kernel
+from mpm_warp.errors import InvalidArgument, ScenarioError
 from mpm_warp.kernels.types import mat33, vec3
-from mpm_warp.pst import run_pst
-from mpm_warp.scenario import load_scenario
+from mpm_warp.loader import load_scenario, scenario_from_dict
+from mpm_warp.scenes.pst.kernels import pst_action_kernel
+from mpm_warp.scenes.weak_layer import weak_layer_kernel
 
 G = 9.81
 
@@ -21,7 +22,7 @@ G = 9.81
 def test_pst_flat_layout():
     sc = load_scenario("pst_flat")
     s = sc.scene
-    L, D, Dwl = s["length"], s["slab_thickness"], s["weak_layer_thickness"]
+    L, D, Dwl = s.length, s.slab_thickness, s.weak_layer_thickness
     blocks = {b.name: b for b in sc.blocks}
     assert blocks["weak_layer"].lo == (0.0, 0.0, 0.0) and blocks["weak_layer"].hi[:2] == (L, Dwl)
     assert blocks["slab"].lo[1] == Dwl and blocks["slab"].hi[1] == pytest.approx(Dwl + D)
@@ -30,20 +31,20 @@ def test_pst_flat_layout():
     (floor,) = sc.walls
     assert floor.kind == "sticky" and floor.normal == (0.0, 1.0, 0.0)
     assert sc.time.gravity == pytest.approx((0.0, -G, 0.0))
-    assert sc.time.damping_until == s["settle"]["duration"] == s["derived"]["saw_start"]
+    assert sc.time.damping_until == s.settle.duration == s.saw_start
     sigma_n = 250.0 * G * D
     assert sc.materials["weak_layer"].p0_ini == pytest.approx(3.0 * sigma_n)
-    assert s["derived"]["sigma_n"] == pytest.approx(sigma_n)
+    assert s.sigma_n == pytest.approx(sigma_n)
     # the hardening law gives ~20 % collapse under this slab (how xi was chosen)
-    assert s["derived"]["collapse_fraction_law"] == pytest.approx(0.20, abs=0.005)
-    assert len(s["derived"]["markers"]) == round(L / s["marker_spacing"])
+    assert s.references()["collapse_fraction_law"] == pytest.approx(0.20, abs=0.005)
+    assert len(s.markers()) == round(L / s.marker_spacing)
 
 
 def test_pst_slope_rotates_gravity():
     sc = load_scenario("pst_slope")
-    th = math.radians(sc.scene["slope_angle"])
+    th = math.radians(sc.scene.slope_angle)
     assert sc.time.gravity == pytest.approx((G * math.sin(th), -G * math.cos(th), 0.0))
-    assert sc.scene["derived"]["sigma_n"] == pytest.approx(250.0 * G * 0.5 * math.cos(th))
+    assert sc.scene.sigma_n == pytest.approx(250.0 * G * 0.5 * math.cos(th))
 
 
 def test_pst_width_gives_3d_column():
@@ -60,16 +61,23 @@ def test_pst_width_gives_3d_column():
     ("scene.weak_layer.failure='ductile'", "failure"),
 ])
 def test_pst_bad_input(override, match):
-    with pytest.raises(ScenarioError, match=match):
+    with pytest.raises((ScenarioError, InvalidArgument), match=match):
         load_scenario("pst_demo", [override])
 
 
 def test_pst_generated_sections_are_not_accepted():
-    from mpm_warp.scenes import expand_scene
-
     raw = {"scene": {"kind": "pst"}, "blocks": [], "time": {"end": 1.0, "frame_interval": 0.1}}
     with pytest.raises(ScenarioError, match="generated"):
-        expand_scene(raw)
+        scenario_from_dict(raw)
+
+
+def test_pst_scene_round_trips_through_the_run_file_dict():
+    """The typed parameters survive Scenario.to_dict (run files, checkpoints): resume rebuilds the same scene."""
+    from mpm_warp.loader import resolved_scenario
+
+    sc = load_scenario("pst_slope", ["scene.saw.from_end='right'", "scene.substratum='separate'"])
+    back = resolved_scenario(sc.to_dict())
+    assert back == sc and back.scene.saw.from_end == "right" and back.walls[0].kind == "separate"
 
 
 # ----------------------------------------------------------------------------- kernels
@@ -151,12 +159,13 @@ SMALL_DEMO = ["scene.length=1.5", "scene.saw.cut_length=0.2", "scene.settle.grav
 
 def test_pst_demo_small_crack_runs(tmp_path):
     out = str(tmp_path / "pst.h5")
-    res, mon = run_pst("pst_demo", output=out, device=DEVICE, overrides=SMALL_DEMO, n_threads=1)
-    ex = res.extra
+    res = mw.run("pst_demo", output=out, device=DEVICE, overrides=SMALL_DEMO, n_threads=1)
+    mon = res.monitor
+    ex = res.scene_result
     t = np.asarray(mon.times)
     front = np.asarray(mon.series["front"])
     L, cut = 1.5, 0.2
-    t_saw = mon.scene["derived"]["saw_start"]
+    t_saw = mon.params.saw_start
     # intact until the saw starts, then a front that only moves forward and crosses the column
     assert np.all(front[t < t_saw] == 0.0)
     assert np.all(np.diff(front) >= 0.0)
@@ -168,7 +177,7 @@ def test_pst_demo_small_crack_runs(tmp_path):
     i_cross = np.nonzero(front >= 0.8 * L)[0][0]
     assert mon.saw_position(t[i_cross]) <= cut + 1e-9
     # the layer collapsed behind the front by about the hardening law's height
-    law = mon.scene["derived"]["collapse_height_law"]
+    law = mon.params.references()["collapse_height_law"]
     assert 0.5 * law < ex["collapse_height"] < 2.0 * law
     assert np.isfinite(ex["touchdown"]) and 0.0 < ex["touchdown"] < L
     # the series are in the run file, with units

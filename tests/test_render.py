@@ -10,10 +10,11 @@ import pytest
 from PIL import Image
 
 import mpm_warp
-from mpm_warp import render
 from mpm_warp.cli import main
 from mpm_warp.errors import InvalidArgument
 from mpm_warp.io import RunWriter, read_run
+from mpm_warp.post import render
+from mpm_warp.post.render import film, gl
 
 SPEED, A0, DT = 20.0, 0.4, 0.01          # synthetic front: x_f = A0 + SPEED t [m], frames every DT [s]
 
@@ -22,12 +23,13 @@ def make_pst(path, n_frames: int = 4, h: float = 0.02, length: float = 2.0, from
     """A PST-like column (base, weak layer, slab) whose weak layer collapses behind a known front.
 
     ``from_end=None`` stores ``front_position`` (x); ``"left"``/``"right"`` store a PST's ``front``
-    and ``saw`` (distances from that end of the column), as :mod:`mpm_warp.pst` does.
+    and ``saw`` (distances from that end of the column), as :mod:`mpm_warp.scenes.pst` does. The
+    collapse reference ``log_jp_ref`` is 0 (the settled layer of this column had ``log_jp = 0``).
     """
     g = np.mgrid[h / 2:length:h, h / 2:0.36:h, h / 2:0.1:h].reshape(3, -1).T
     group = np.where(g[:, 1] < 0.04, 0, np.where(g[:, 1] < 0.06, 1, 2)).astype(np.uint8)
     fields = {"x": ((3,), "float32", "m"), "v": ((3,), "float32", "m/s"), "log_jp": ((), "float32", "1"),
-              "p": ((), "float32", "Pa"), "q": ((), "float32", "Pa")}
+              "log_jp_ref": ((), "float32", "1"), "p": ((), "float32", "Pa"), "q": ((), "float32", "Pa")}
     scene = {"kind": "pst"} if from_end is None else {"kind": "pst", "length": length, "saw": {"from_end": from_end}}
     series = {"front_position": "m"} if from_end is None else {"front": "m", "saw": "m"}
     dist = g[:, 0] if from_end != "right" else length - g[:, 0]     # distance from the saw's end
@@ -47,7 +49,7 @@ def make_pst(path, n_frames: int = 4, h: float = 0.02, length: float = 2.0, from
             if from_end is not None:                   # the sawn cut: log_jp = 5 as pst.py's saw sets it
                 log_jp[(group == 1) & (dist < front["saw"])] = 5.0
             w.write_frame(t, 100 * k, {"x": x, "v": -0.1 * behind[:, None] * [0, 1, 0], "log_jp": log_jp,
-                                       "p": 1000.0 * g[:, 0] + k, "q": 50.0 * g[:, 1]},
+                                       "log_jp_ref": np.zeros(len(g)), "p": 1000.0 * g[:, 0] + k, "q": 50.0 * g[:, 1]},
                           scalars={**front, "kinetic_energy": t})
     return str(path)
 
@@ -152,7 +154,7 @@ def test_oblique_view_and_gif(pst, tmp_path):
 
 
 def test_mp4_without_ffmpeg_is_a_clear_error(pst, tmp_path, monkeypatch):
-    monkeypatch.setattr(render.shutil, "which", lambda name: None)
+    monkeypatch.setattr(film.shutil, "which", lambda name: None)
     monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)
     with pytest.raises(render.RenderingUnavailable, match="ffmpeg"):
         render.render_run(pst, field="q", frames="-1", out_dir=tmp_path, size=(128, 128), video="mp4")
@@ -182,9 +184,9 @@ def test_parse_frames():
 
 def test_gl_backend_choice(monkeypatch):
     libs = set()
-    monkeypatch.setattr(render, "_has_lib", lambda name: name in libs)
-    monkeypatch.setattr(render.glob, "glob", lambda pattern: [])
-    monkeypatch.setattr(render.sys, "platform", "linux")
+    monkeypatch.setattr(gl, "_has_lib", lambda name: name in libs)
+    monkeypatch.setattr(gl.glob, "glob", lambda pattern: [])
+    monkeypatch.setattr(gl.sys, "platform", "linux")
     assert render.choose_gl_backend({"VTK_DEFAULT_OPENGL_WINDOW": "vtkXOpenGLRenderWindow"}) == (None, None)
     assert render.choose_gl_backend({"DISPLAY": ":0"}) == (None, None)
     window, problem = render.choose_gl_backend({})
@@ -198,7 +200,7 @@ def test_gl_backend_choice(monkeypatch):
 
 
 def test_missing_gl_is_a_clear_error(pst, tmp_path, monkeypatch):
-    monkeypatch.setattr(render, "choose_gl_backend", lambda: (None, "off-screen rendering is unavailable: no libEGL"))
+    monkeypatch.setattr(gl, "choose_gl_backend", lambda: (None, "off-screen rendering is unavailable: no libEGL"))
     with pytest.raises(render.RenderingUnavailable, match="libEGL"):
         render.render_run(pst, out_dir=tmp_path)
 

@@ -1,4 +1,4 @@
-"""Checkpoints and resume: bit for bit on the CPU, from the API and from a real interrupted CLI run."""
+"""Checkpoints and resume: bit for bit on the CPU (plain blocks, a PST, a shear test), from the API and the CLI."""
 
 import os
 import signal
@@ -7,6 +7,7 @@ import sys
 import time
 
 import numpy as np
+import pytest
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
@@ -80,3 +81,82 @@ def test_cli_interrupted_by_signal_keeps_frames_and_resumes(tmp_path):
     assert res.returncode == 0, res.stderr
     run = mw.read_run(str(out))
     assert run.n_frames == 61 and abs(run.times[-1] - 0.3) < 1e-12
+
+
+# ------------------------------------------------------------------ scenes: the monitors' state is checkpointed
+#: a small PST (0.6 m column, 3.8k particles): settled by 0.04 s, sawn from then on, run to 0.08 s
+TINY_PST = ["scene.length=0.6", "scene.slab_thickness=0.15", "scene.saw.cut_length=0.15",
+            "scene.settle.gravity_ramp=0.02", "scene.settle.duration=0.04", "time.end=0.08",
+            "time.frame_interval=0.005", "output.checkpoint_every=1"]
+#: a small shear test (560 particles): settled by 0.05 s, pushed from then on, run to 0.09 s
+TINY_SHEAR = ["scene.dx=0.01", "scene.sample_length=0.1", "scene.settle.gravity_ramp=0.03",
+              "scene.settle.duration=0.05", "time.end=0.09", "time.frame_interval=0.005",
+              "output.checkpoint_every=1", 'output.fields=["x", "log_jp"]']
+
+
+def _same_result(a: dict, b: dict) -> None:
+    assert a.keys() == b.keys()
+    for k in a:
+        np.testing.assert_array_equal(np.asarray(a[k]), np.asarray(b[k]), err_msg=k)
+
+
+def _interrupted_equals_uninterrupted(tmp_path, scene: str, overrides: list, t_stop: float, device_keys) -> None:
+    """Run straight through; run again stopped at ``t_stop`` (after settling) and resumed: bit for bit equal."""
+    full = mw.run(scene, str(tmp_path / "full.h5"), DEVICE, overrides, n_threads=1)
+    part = str(tmp_path / "part.h5")
+    stopped = mw.run(scene, part, DEVICE, overrides, n_threads=1, callback=lambda sim, k: sim.time < t_stop - 1e-12)
+    assert stopped.sim_time == pytest.approx(t_stop)
+    arrays, meta = io.read_checkpoint(io.checkpoint_path_for(part))
+    name = stopped.monitor.name
+    assert meta["monitors"] == [name] and arrays["vmax"].size == 1
+    for k in device_keys:   # the scene's device state at the stop is not trivial: losing it would show
+        assert f"monitors/{name}/device/{k}" in arrays
+    res = mw.resume(part, device=DEVICE, n_threads=1)
+    a, b = mw.read_run(str(tmp_path / "full.h5")), mw.read_run(part)
+    assert a.n_frames == b.n_frames and a.particle_fields == b.particle_fields
+    np.testing.assert_array_equal(a.times, b.times)
+    np.testing.assert_array_equal(a.steps, b.steps)
+    for k in range(a.n_frames):
+        fa, fb = a.frame(k), b.frame(k)
+        for n in a.particle_fields:
+            np.testing.assert_array_equal(fa[n], fb[n], err_msg=f"frame {k} {n}")
+    assert a.scalars.keys() == b.scalars.keys()
+    for n in a.scalars:
+        np.testing.assert_array_equal(a.scalars[n], b.scalars[n], err_msg=n)
+    assert full.monitor.times == res.monitor.times and full.monitor.series == res.monitor.series
+    _same_result(full.scene_result, res.scene_result)
+    return full, res, arrays
+
+
+def test_pst_interrupted_after_settling_resumes_bit_for_bit(tmp_path):
+    full, res, arrays = _interrupted_equals_uninterrupted(tmp_path, "pst_demo", TINY_PST, 0.055,
+                                                          ["weak_layer/ref", "weak_layer/failed", "arrival"])
+    ck = "monitors/pst/device/"
+    assert (arrays[ck + "weak_layer/failed"] == 2).any()            # sawn particles at the stop
+    assert np.isfinite(arrays[ck + "arrival"]).any()                 # and front arrival times
+    assert len(arrays["monitors/pst/series/times"]) == 12            # frames 0..11 recorded before the stop
+    np.testing.assert_array_equal(full.monitor.arrival.numpy(), res.monitor.arrival.numpy())
+    np.testing.assert_array_equal(full.monitor.weak.ref.numpy(), res.monitor.weak.ref.numpy())
+
+
+def test_shear_test_interrupted_while_pushing_resumes_bit_for_bit(tmp_path):
+    _, res, arrays = _interrupted_equals_uninterrupted(tmp_path, "shear_test", TINY_SHEAR, 0.07,
+                                                       ["impulse", "last", "weak_layer/ref"])
+    ck = "monitors/shear_test/device/"
+    assert arrays[ck + "impulse"][0] != 0.0 and arrays[ck + "last"][0] == pytest.approx(0.07)
+    assert res.monitor.series["shear_stress"][-1] != 0.0
+    assert "log_jp_ref" in mw.read_run(str(tmp_path / "part.h5")).particle_fields     # compared frame by frame
+
+
+def test_resume_on_another_thread_count(tmp_path):
+    """vmax is stored as one number: a run checkpointed on 2 threads resumes on 1 (same steps, round-off apart)."""
+    overrides = ["time.end=0.06", "time.frame_interval=0.01", "output.checkpoint_every=1"]
+    full = mw.run("elastic_block", str(tmp_path / "full.h5"), DEVICE, overrides, n_threads=2)
+    part = str(tmp_path / "part.h5")
+    mw.run("elastic_block", part, DEVICE, overrides, n_threads=2, callback=lambda sim, k: k < 3)
+    arrays, _ = io.read_checkpoint(io.checkpoint_path_for(part))
+    assert arrays["vmax"].size == 1 and arrays["vmax"] > 0.0
+    res = mw.resume(part, device=DEVICE, n_threads=1)
+    a, b = mw.read_run(str(tmp_path / "full.h5")), mw.read_run(part)
+    assert res.steps + int(b.steps[3]) == full.steps      # the same step sizes: the speed bound carried over
+    np.testing.assert_allclose(b.frame(-1)["x"], a.frame(-1)["x"], atol=1e-6)

@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
+import mpm_warp as mw
 from mpm_warp.errors import ScenarioError
-from mpm_warp.scenario import load_scenario
-from mpm_warp.shear_test import run_shear_test, shear_curves
+from mpm_warp.loader import load_scenario
+from mpm_warp.scenes.shear_test import shear_curves
 
 G = 9.81
 
@@ -14,18 +15,17 @@ G = 9.81
 def test_shear_test_layout():
     sc = load_scenario("shear_test")
     s = sc.scene
-    d = s["derived"]
     sigma_n = 250.0 * G * 0.5
-    assert d["sigma_n"] == pytest.approx(sigma_n)
-    assert sc.materials["load"].density == pytest.approx(sigma_n / (G * s["load_thickness"]))
+    assert s.sigma_n == pytest.approx(sigma_n)
+    assert sc.materials["load"].density == pytest.approx(sigma_n / (G * s.load_thickness))
     assert sc.materials["weak_layer"].p0_ini == pytest.approx(3.0 * sigma_n)
     blocks = {b.name: b for b in sc.blocks}
-    assert blocks["weak_layer"].hi[:2] == pytest.approx((s["sample_length"], s["weak_layer_thickness"]))
-    assert blocks["load"].lo[1] == pytest.approx(s["weak_layer_thickness"])
-    assert blocks["load"].hi[0] == pytest.approx(s["sample_length"])
+    assert blocks["weak_layer"].hi[:2] == pytest.approx((s.sample_length, s.weak_layer_thickness))
+    assert blocks["load"].lo[1] == pytest.approx(s.weak_layer_thickness)
+    assert blocks["load"].hi[0] == pytest.approx(s.sample_length)
     (floor,) = sc.walls  # the push is a device action on the loading block, not a wall
     assert floor.kind == "sticky"
-    assert d["push_start"] == s["settle"]["duration"]
+    assert s.push_start == s.settle.duration
 
 
 def test_shear_test_bad_input():
@@ -38,10 +38,11 @@ COARSE = ["scene.dx=0.01", "time.end=0.4", "time.frame_interval=0.001"]
 
 
 def test_shear_test_peak_then_softening():
-    res, mon = run_shear_test("shear_test", device=DEVICE, overrides=COARSE, n_threads=1)
+    res = mw.run("shear_test", device=DEVICE, overrides=COARSE, n_threads=1)
+    mon = res.monitor
     series = {k: np.asarray(v) for k, v in mon.series.items()}
-    c = shear_curves(mon.scene, mon.times, series)
-    ex = res.extra
+    c = shear_curves(mon.params, mon.times, series)
+    ex = res.scene_result
     n0 = len(mon.times) - len(c["tau"])
     failed = series["failed_fraction"][n0:]
     assert failed[0] == 0.0  # at rest under the slab's load the layer is intact

@@ -15,7 +15,7 @@ from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
 from mpm_warp.io import checkpoint_path_for, read_checkpoint
-from mpm_warp.model import SINGULAR_VALUE_FLOOR
+from mpm_warp.stress import cauchy_stress, kirchhoff_stress
 
 G = 9.81
 
@@ -30,31 +30,12 @@ def _rotation(rng: np.random.Generator) -> np.ndarray:
     return q
 
 
-def _kirchhoff_reference(F: np.ndarray, mu: float, lam: float, floor: float = SINGULAR_VALUE_FLOOR) -> np.ndarray:
-    """Hencky Kirchhoff stress (Pa) of one F_E in float64 numpy (MODEL.md 1).
-
-    Signed SVD: U, V rotations, the smallest singular value carries the sign of
-    det F (the ``wp.svd3`` convention), floored at ``floor`` before the log.
-    """
-    U, s, Vt = np.linalg.svd(np.asarray(F, dtype=np.float64))
-    if np.linalg.det(U @ Vt) < 0:
-        s = s.copy()
-        s[-1] = -s[-1]
-    eps = np.log(np.maximum(s, floor))
-    return U @ np.diag(2.0 * mu * eps + lam * eps.sum()) @ U.T
-
-
 def _cauchy_yy(sim: mw.Simulation) -> np.ndarray:
-    """sigma_yy (Pa, tension positive) of every particle, from F_E in float64 numpy."""
+    """sigma_yy (Pa, tension positive) of every particle, from F_E by the float64 host mirror."""
     F = sim.state.elastic_deformation_gradient()
     out = np.zeros(len(F))
     for g in sim.model.groups:
-        Fg = F[g.start:g.end]
-        U, s, _ = np.linalg.svd(Fg)
-        eps = np.log(s)
-        tau = 2.0 * g.material.mu * eps + g.material.lam * eps.sum(axis=1, keepdims=True)
-        tau_m = np.einsum("nij,nj,nkj->nik", U, tau, U)
-        out[g.start:g.end] = tau_m[:, 1, 1] / np.linalg.det(Fg)
+        out[g.start:g.end] = cauchy_stress(F[g.start:g.end], g.material.mu, g.material.lam)[:, 1, 1]
     return out
 
 
@@ -570,7 +551,7 @@ def test_nearly_singular_and_inverted_F_give_finite_exact_stress(precision, tol)
     sim.state.set_elastic_deformation_gradient(F[np.argsort(idx)])
     p, q = sim.stress_invariants()
     assert np.isfinite(p).all() and np.isfinite(q).all()
-    ref = np.array([_kirchhoff_reference(Fi, SNOW.mu, SNOW.lam) for Fi in F_list])
+    ref = kirchhoff_stress(np.asarray(F_list), SNOW.mu, SNOW.lam)
     p_ref = -np.trace(ref, axis1=1, axis2=2) / 3.0
     np.testing.assert_allclose(p[idx], p_ref, rtol=tol)
 
@@ -655,13 +636,13 @@ def test_repeated_singular_values_any_singular_vectors(precision, tol):
             assert p[i] == pytest.approx(-iso, rel=tol)
             assert abs(q[i]) <= 10 * tol * abs(iso)
     s0 = np.abs(tau[8]).max()
-    np.testing.assert_allclose(tau[8], _kirchhoff_reference(F0, SNOW.mu, SNOW.lam), atol=tol * s0)
+    np.testing.assert_allclose(tau[8], kirchhoff_stress(F0, SNOW.mu, SNOW.lam)[0], atol=tol * s0)
     np.testing.assert_allclose(tau[9], tau[8], atol=tol * s0)
     np.testing.assert_allclose(tau[10], Q @ tau[8] @ Q.T, atol=tol * s0)
     assert p[9] == pytest.approx(p[8], rel=tol) and p[10] == pytest.approx(p[8], rel=tol)
     assert q[9] == pytest.approx(q[8], rel=10 * tol) and q[10] == pytest.approx(q[8], rel=10 * tol)
     s1 = np.abs(tau[11]).max()
-    np.testing.assert_allclose(tau[11], _kirchhoff_reference(F1, SNOW.mu, SNOW.lam), atol=10 * tol * s1)
+    np.testing.assert_allclose(tau[11], kirchhoff_stress(F1, SNOW.mu, SNOW.lam)[0], atol=10 * tol * s1)
     np.testing.assert_allclose(tau[12], tau[11], atol=10 * tol * s1)
 
 

@@ -71,10 +71,11 @@ def test_cases_file(tmp_path):
 
 
 def test_run_id_is_hash_of_effective_scenario():
-    raw = {"name": "s", "time": {"end": 1.0}, "scene": {"slope_deg": 0}}
-    ids = [t["id"] for t in _tasks(raw, "s.toml", [{"time.end": "2.0"}, {"time.end": 2.0}, {"time.end": "3.0"},
-                                                   {"slope_deg": 30}, {"scene.slope_deg": 30}], [], ".", None, None)]
-    assert ids[0].startswith("s-") and len(ids) == 3          # 2.0 == "2.0"; slope_deg means scene.slope_deg
+    raw = {"name": "s", "time": {"end": 1.0}, "scene": {"slope_angle": 0}}
+    cases = [{"time.end": "2.0"}, {"time.end": 2.0}, {"time.end": "3.0"}, {"slope_angle": 30},
+             {"scene.slope_angle": 30}]
+    ids = [t["id"] for t in _tasks(raw, "s.toml", cases, [], ".", None, None)]
+    assert ids[0].startswith("s-") and len(ids) == 3          # 2.0 == "2.0"; slope_angle means scene.slope_angle
     assert _tasks(raw, "s.toml", [{}], [("time.end", 2.0)], ".", None, None)[0]["id"] == ids[0]
 
 

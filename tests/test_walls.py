@@ -244,3 +244,14 @@ def test_box_faces_constrain_nodes_on_them(dx):
     assert np.abs(v[:, 1:]).max() < 1e-4 * 0.05  # 2e-2 * v0 when a face acts one cell out
     assert np.abs(F[:, 1, 1] - 1.0).max() < 1e-6
     assert np.abs(F[:, 2, 2] - 1.0).max() < 1e-6
+
+
+def test_wall_kinds_are_one_tuple_matching_the_kernel_codes():
+    """WALL_KINDS (from the WallKind Literal) is the one list: its order is the kernel's integer codes."""
+    from mpm_warp.config import BOUNDARIES
+    from mpm_warp.kernels.grid_update import SEPARATE, SLIP, STICKY
+    from mpm_warp.walls import WALL_KINDS
+
+    assert WALL_KINDS == ("sticky", "slip", "separate")
+    assert [mw.Wall((0, 0, 0), (0, 1, 0), kind=k).kind_id for k in WALL_KINDS] == [STICKY, SLIP, SEPARATE]
+    assert BOUNDARIES == (*WALL_KINDS, "none")

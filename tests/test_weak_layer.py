@@ -87,9 +87,9 @@ import pytest
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
+from mpm_warp.materials import hardening_collapse
 from mpm_warp.validation import (
     consolidation_pressure,
-    hardening_collapse,
     measure_column,
     oedometric_collapse,
     oedometric_point,
@@ -141,8 +141,8 @@ def test_oedometric_closed_form_matches_material_point(xi, p0_ini):
     assert closed == pytest.approx(c, rel=CLOSED_FORM_TOL)
     assert st["p0"] / st["tau_v"] == pytest.approx(1.0 / oedometric_ratio(mat.M, mat.beta), rel=CLOSED_FORM_TOL)
     assert st["p0"] == pytest.approx(consolidation_pressure(st["p"], st["q"], mat.M, mat.beta), rel=1e-3)
-    assert hardening_collapse(W, p0_ini, mat.bulk, xi) / c - 1.0 > 0.1  # isotropic formula with p = W
-    assert hardening_collapse(W / oedometric_ratio(mat.M, mat.beta), p0_ini, mat.bulk, xi) / c - 1.0 > 0.04
+    assert hardening_collapse(W, mat.bulk, xi, p0_ini) / c - 1.0 > 0.1  # isotropic formula with p = W
+    assert hardening_collapse(W / oedometric_ratio(mat.M, mat.beta), mat.bulk, xi, p0_ini) / c - 1.0 > 0.04
 
 
 def test_oedometric_ratio_closed_form():

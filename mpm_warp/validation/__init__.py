@@ -34,11 +34,10 @@ ladders of ``dx`` and CFL factor.
 
 from __future__ import annotations
 
-from .common import G, com_velocity, hencky_cauchy_stress, kirchhoff_stress, observed_order, zero_crossings
+from .common import G, com_velocity, observed_order, zero_crossings
 from .elastic import axial_bar, bar_period, column_scenario, fixed_free_bar, self_weight_column
 from .weak_layer import (
     consolidation_pressure,
-    hardening_collapse,
     measure_column,
     oedometric_collapse,
     oedometric_point,
@@ -52,9 +51,8 @@ from .weak_layer import (
 __all__ = [
     "PROBLEMS", "G", "axial_bar", "self_weight_column", "weak_layer_collapse",
     "fixed_free_bar", "bar_period", "column_scenario", "weak_layer_column", "run_column", "measure_column",
-    "oedometric_ratio", "oedometric_point", "consolidation_pressure", "hardening_collapse", "oedometric_collapse",
-    "oedometric_state", "com_velocity", "zero_crossings", "observed_order", "hencky_cauchy_stress",
-    "kirchhoff_stress",
+    "oedometric_ratio", "oedometric_point", "consolidation_pressure", "oedometric_collapse",
+    "oedometric_state", "com_velocity", "zero_crossings", "observed_order",
 ]
 
 #: the problems by name: ``PROBLEMS[name](dx, cfl=..., dt=..., precision=..., device=...) -> record``

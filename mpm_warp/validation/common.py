@@ -16,9 +16,9 @@ G = 9.81
 
 # ------------------------------------------------------------------ measuring
 def com_velocity(sim: Simulation) -> np.ndarray:
-    """Mass-weighted mean particle velocity (m/s), shape (3,)."""
+    """Mass-weighted mean particle velocity (m/s), shape (dim,)."""
     v = sim.state.v.numpy().astype(np.float64)
-    p = np.zeros(3)
+    p = np.zeros(v.shape[1])
     m = 0.0
     for g in sim.model.groups:
         p += g.mass * v[g.start:g.end].sum(axis=0)
@@ -54,24 +54,6 @@ def zero_crossings(t, y, cubic: bool = False) -> np.ndarray:
 def observed_order(h, err) -> float:
     """Slope of ``log(err)`` against ``log(h)`` (least squares, ``np.polyfit``)."""
     return float(np.polyfit(np.log(np.asarray(h, float)), np.log(np.asarray(err, float)), 1)[0])
-
-
-def kirchhoff_stress(F, mu: float, lam: float) -> np.ndarray:
-    """Hencky Kirchhoff stress ``U diag(2 mu ln s + lam tr ln s) U^T`` (Pa, tension positive).
-
-    ``F = U diag(s) V^T`` of shape (n, 3, 3); computed in float64 with numpy,
-    independently of the kernels (MODEL.md 1).
-    """
-    U, s, _ = np.linalg.svd(np.asarray(F, dtype=np.float64))
-    eps = np.log(s)
-    t = 2.0 * mu * eps + lam * eps.sum(axis=-1, keepdims=True)
-    return np.einsum("nij,nj,nkj->nik", U, t, U)
-
-
-def hencky_cauchy_stress(F, mu: float, lam: float) -> np.ndarray:
-    """Hencky Cauchy stress ``tau / det F`` (Pa, tension positive), shape (n, 3, 3), float64."""
-    F = np.asarray(F, dtype=np.float64)
-    return kirchhoff_stress(F, mu, lam) / np.linalg.det(F)[:, None, None]
 
 
 def _cells(name: str, length: float, dx: float) -> int:

@@ -6,23 +6,25 @@ import math
 
 import numpy as np
 
+from ..config import Block, Domain, Scenario, TimeControl
 from ..errors import MPMError
 from ..materials import Elastic
-from ..scenario import Block, Domain, Scenario, TimeControl
 from ..simulation import Simulation
+from ..stress import cauchy_stress
 from ..walls import Wall
-from .common import G, _cells, _record, com_velocity, hencky_cauchy_stress, zero_crossings
+from .common import G, _cells, _record, com_velocity, zero_crossings
 
 
 # ------------------------------------------------------------------ axial bar
 def fixed_free_bar(*, length: float, E: float, nu: float, density: float, v0: float, dx: float,
                    width_cells: int = 1, periods: float = 1.35, samples_per_period: int = 200,
                    cfl: float = 0.4, dt: float | None = None,
-                   precision: str = "float32") -> tuple[Scenario, float]:
+                   precision: str = "float32", dimension: int = 3) -> tuple[Scenario, float]:
     """Quasi-1D bar along x, fixed at x = 0, free at x = ``length``, in its first mode.
 
-    The cross-section is ``width_cells`` cells square between slip walls on the
-    y and z faces (lateral confinement: uniaxial strain); a sticky wall at
+    The cross-section is ``width_cells`` cells square (``width_cells`` cells
+    high in 2D, ``dimension = 2``: plane strain) between slip walls on the y
+    (and z) faces (lateral confinement: uniaxial strain); a sticky wall at
     x = 0 fixes that end; the domain extends 4 cells past the free end. The
     initial velocity is ``v0 sin(pi x / (2 L))`` (m/s) along x, no gravity.
 
@@ -41,14 +43,16 @@ def fixed_free_bar(*, length: float, E: float, nu: float, density: float, v0: fl
         v[:, 0] = v0 * np.sin(np.pi * x[:, 0] / (2.0 * length))
         return v
 
+    d = dimension
     sc = Scenario(
         name="fixed_free_bar",
-        domain=Domain((0.0, 0.0, 0.0), (length + 4 * dx, w, w), dx, boundary="slip", boundary_faces="yz"),
+        domain=Domain((0.0,) * d, (length + 4 * dx, w, w)[:d], dx, boundary="slip", boundary_faces="yz",
+                      dimension=d),
         time=TimeControl(end=periods * period, frame_interval=period / samples_per_period, cfl=cfl,
-                         dt=dt or 0.0, gravity=(0.0, 0.0, 0.0)),
+                         dt=dt or 0.0, gravity=(0.0,) * d),
         materials={"bar": mat},
-        blocks=(Block("bar", (0.0, 0.0, 0.0), (length, w, w), velocity=mode1),),
-        walls=(Wall((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), kind="sticky", name="fixed_end"),),
+        blocks=(Block("bar", (0.0,) * d, (length, w, w)[:d], velocity=mode1),),
+        walls=(Wall((0.0,) * d, (1.0, 0.0, 0.0)[:d], kind="sticky", name="fixed_end"),),
         precision=precision,
     )
     return sc, period
@@ -84,7 +88,7 @@ def bar_period(sc: Scenario, device: str | None = "cpu",
 
 def axial_bar(dx: float = 1.0, *, cfl: float = 0.4, dt: float | None = None, precision: str = "float32",
               device: str | None = None, n_threads: int | None = None, length: float = 25.0, E: float = 100.0,
-              density: float = 1.0, v0: float = 0.1) -> dict:
+              density: float = 1.0, v0: float = 0.1, dimension: int = 3) -> dict:
     """Fixed-free axial bar, mode 1: period error (VALIDATION.md "Elastic").
 
     L = 25, E = 100, rho = 1, nu = 0, v0 = 0.1 by default: ``T = 4 L / c = 10 s``.
@@ -105,6 +109,8 @@ def axial_bar(dx: float = 1.0, *, cfl: float = 0.4, dt: float | None = None, pre
         CPU threads (see :class:`Simulation`).
     length, E, density, v0 : float
         Bar length (m), Young's modulus (Pa), density (kg/m^3), velocity amplitude (m/s).
+    dimension : {2, 3}
+        2 runs the true 2D plane-strain kernels.
 
     Returns
     -------
@@ -121,7 +127,7 @@ def axial_bar(dx: float = 1.0, *, cfl: float = 0.4, dt: float | None = None, pre
     T_c = 4.0 * length / math.sqrt(E / density)
     spp = int(min(200, max(20, T_c / (4.0 * (dt or cfl * dx / math.sqrt(E / density))))))
     sc, T_exact = fixed_free_bar(length=length, E=E, nu=0.0, density=density, v0=v0, dx=dx, cfl=cfl, dt=dt,
-                                 samples_per_period=spp, precision=precision)
+                                 samples_per_period=spp, precision=precision, dimension=dimension)
     T, t, v, sim, res = _run_bar(sc, device, n_threads, cubic=True)
     amp = 2.0 / math.pi * v0
     details = {"samples_per_period": spp, "com_velocity_min_over_amplitude": float(-v.min() / amp),
@@ -131,8 +137,9 @@ def axial_bar(dx: float = 1.0, *, cfl: float = 0.4, dt: float | None = None, pre
 
 # ----------------------------------------------------- column under self-weight
 def column_scenario(dx: float, *, height: float = 1.0, E: float = 1.0e6, nu: float = 0.3, density: float = 250.0,
-                    cfl: float = 0.4, dt: float | None = None, precision: str = "float64") -> tuple[Scenario, dict]:
-    """Column of ``height`` one cell square between slip (roller) faces, gravity ramped, then held.
+                    cfl: float = 0.4, dt: float | None = None, precision: str = "float64",
+                    dimension: int = 3) -> tuple[Scenario, dict]:
+    """Column of ``height``, one cell square (one cell wide in 2D), between slip faces; gravity ramped, then held.
 
     A linear ramp lasting ten mode-1 periods ``T1 = 4 H / c_p`` leaves almost no free
     vibration of the fixed-free column (all its modes have periods ``T1 / (2k - 1)``);
@@ -142,13 +149,15 @@ def column_scenario(dx: float, *, height: float = 1.0, E: float = 1.0e6, nu: flo
     mat = Elastic(E, nu, density)
     T1 = 4.0 * height / mat.p_wave_speed
     ramp = 10.0 * T1
+    d = dimension
     sc = Scenario(
         name="column_self_weight",
-        domain=Domain((0.0, 0.0, 0.0), (dx, height + 2 * dx, dx), dx, boundary="slip", boundary_faces="xyz"),
+        domain=Domain((0.0,) * d, (dx, height + 2 * dx, dx)[:d], dx, boundary="slip", boundary_faces="xyz",
+                      dimension=d),
         time=TimeControl(end=ramp + 2.0 * T1, frame_interval=T1 / 20.0, cfl=cfl, dt=dt or 0.0,
-                         gravity=(0.0, -G, 0.0), gravity_ramp=ramp),
+                         gravity=(0.0, -G, 0.0)[:d], gravity_ramp=ramp),
         materials={"snow": mat},
-        blocks=(Block("snow", (0.0, 0.0, 0.0), (dx, height, dx)),),
+        blocks=(Block("snow", (0.0,) * d, (dx, height, dx)[:d]),),
         precision=precision,
     )
     return sc, {"T1": T1, "ramp": ramp, "height": height}
@@ -156,7 +165,8 @@ def column_scenario(dx: float, *, height: float = 1.0, E: float = 1.0e6, nu: flo
 
 def self_weight_column(dx: float = 1.0 / 16.0, *, cfl: float = 0.4, dt: float | None = None,
                        precision: str = "float64", device: str | None = None, n_threads: int | None = None,
-                       height: float = 1.0, E: float = 1.0e6, nu: float = 0.3, density: float = 250.0) -> dict:
+                       height: float = 1.0, E: float = 1.0e6, nu: float = 0.3, density: float = 250.0,
+                       dimension: int = 3) -> dict:
     """Column under self-weight with lateral rollers: ``sigma_yy(Y) = -rho g (H - Y)`` (VALIDATION.md).
 
     Hencky Cauchy stress computed in numpy from ``F_E``, averaged over the last
@@ -167,9 +177,9 @@ def self_weight_column(dx: float = 1.0 / 16.0, *, cfl: float = 0.4, dt: float | 
     ----------
     dx : float
         Grid spacing (m); ``height / dx`` must be a whole number (the tests use H/8, H/16, H/32).
-    cfl, dt, precision, device, n_threads
-        As :func:`axial_bar`. float64 by default: float32 round-off accumulated
-        in F_E over thousands of steps is about 1e-3 of ``rho g H``.
+    cfl, dt, precision, device, n_threads, dimension
+        As :func:`axial_bar`. float64 by default (float32 keeps F_E - I, so its
+        round-off is that of the strain, not of the stretch).
     height, E, nu, density : float
         H (m), Young's modulus (Pa), Poisson's ratio, density (kg/m^3).
 
@@ -185,7 +195,8 @@ def self_weight_column(dx: float = 1.0 / 16.0, *, cfl: float = 0.4, dt: float | 
         boundary layer a fixed number of cells thick, see the tests).
     """
     _cells("height", height, dx)
-    sc, info = column_scenario(dx, height=height, E=E, nu=nu, density=density, cfl=cfl, dt=dt, precision=precision)
+    sc, info = column_scenario(dx, height=height, E=E, nu=nu, density=density, cfl=cfl, dt=dt, precision=precision,
+                               dimension=dimension)
     mat = sc.materials["snow"]
     t_avg = info["ramp"] + info["T1"] * (1.0 + 1e-9)
     sim = Simulation(sc, device=device, n_threads=n_threads)
@@ -193,7 +204,7 @@ def self_weight_column(dx: float = 1.0 / 16.0, *, cfl: float = 0.4, dt: float | 
 
     def sample(s, frame):
         if s.time > t_avg:
-            samples.append(hencky_cauchy_stress(s.state.elastic_deformation_gradient(), mat.mu, mat.lam)[:, 1, 1])
+            samples.append(cauchy_stress(s.state.elastic_deformation_gradient(), mat.mu, mat.lam)[:, 1, 1])
 
     res = sim.run(None, callback=sample)
     syy = np.mean(samples, axis=0)

@@ -6,11 +6,12 @@ import math
 
 import numpy as np
 
-from ..materials import CamClaySnow, Elastic
-from ..scenario import Block, Domain, Output, Scenario, TimeControl
+from ..config import Block, Domain, Output, Scenario, TimeControl
+from ..materials import CamClaySnow, Elastic, hardening_collapse
 from ..simulation import Simulation
+from ..stress import kirchhoff_stress, pressure_and_mises
 from ..walls import Wall
-from .common import G, _cells, _record, kirchhoff_stress
+from .common import G, _cells, _record
 
 
 # ------------------------------------------------- weak layer: closed form
@@ -47,11 +48,6 @@ def consolidation_pressure(p, q, M: float, beta: float):
     return (-b + np.sqrt(b * b + 4.0 * beta * c)) / (2.0 * beta)
 
 
-def hardening_collapse(p0, p0_ini: float, K: float, xi: float):
-    """``1 - J_P / J_P(0) = 1 - exp(-(asinh(p0/K) - asinh(p0_ini/K)) / xi)`` (MODEL.md 3, 6); p0, K in Pa."""
-    return 1.0 - np.exp(-(np.arcsinh(np.asarray(p0, dtype=np.float64) / K) - math.asinh(p0_ini / K)) / xi)
-
-
 def oedometric_collapse(W, mat: CamClaySnow) -> np.ndarray:
     """Closed-form collapse ``1 - J_P`` of a laterally confined layer under the Cauchy load ``W`` (Pa).
 
@@ -70,7 +66,7 @@ def oedometric_collapse(W, mat: CamClaySnow) -> np.ndarray:
         c = 0.5 * (lo + hi)
         p0 = W * (1.0 - c) / lam_oed
         p0 = p0 * np.exp(-p0 * p_over_p0 / K)
-        g = c - np.maximum(hardening_collapse(p0, mat.p0_ini, K, xi), 0.0)
+        g = c - hardening_collapse(p0, K, xi, mat.p0_ini)
         hi = np.where(g > 0, c, hi)
         lo = np.where(g > 0, lo, c)
     return 0.5 * (lo + hi)
@@ -162,9 +158,7 @@ def measure_column(sim: Simulation, wl: CamClaySnow, info: dict) -> dict:
     ljp = sim.particle_field("log_jp")[sl].astype(np.float64)
     F = sim.state.elastic_deformation_gradient()[sl]
     tau = kirchhoff_stress(F, wl.mu, wl.lam)
-    p = -np.trace(tau, axis1=1, axis2=2) / 3.0
-    dev = tau + p[:, None, None] * np.eye(3)
-    q = np.sqrt(1.5 * np.einsum("nij,nij->n", dev, dev))
+    p, q = pressure_and_mises(tau)
     tau_v = -tau[:, 1, 1]
     dl = ljp - wl.initial_log_jp
     J = np.linalg.det(F) * np.exp(dl)
@@ -185,7 +179,7 @@ def measure_column(sim: Simulation, wl: CamClaySnow, info: dict) -> dict:
         "collapse_theory": float(theory.mean()),
         "collapse_interior": float(collapse[inner].mean()) if inner.any() else float("nan"),
         "collapse_theory_interior": float(theory[inner].mean()) if inner.any() else float("nan"),
-        "collapse_theory_own_state": float(hardening_collapse(p0_ell, wl.p0_ini, K, wl.xi).mean()),
+        "collapse_theory_own_state": float(hardening_collapse(p0_ell, K, wl.xi, wl.p0_ini).mean()),
         "h_c": float(collapse.mean() * info["D_wl"]),
         "thickness_change": float(info["D_wl"] - D_now),
         "thickness_change_from_J": float(info["D_wl"] * (1.0 - J.mean())),

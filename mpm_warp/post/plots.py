@@ -24,61 +24,12 @@ import re
 
 import numpy as np
 
-from .errors import InvalidArgument
-from .fronts import steady_speed
-from .io import RunData, read_run
+from ..io import RunData, read_run
+from .fronts import front_name, front_speed
 
-__all__ = ["fit_front_speed", "plot_run", "plot_front", "plot_markers", "plot_shear", "plot_energy", "add_cli"]
+__all__ = ["plot_run", "plot_front", "plot_markers", "plot_shear", "plot_energy"]
 
 _MARKER = re.compile(r"^marker_?(.+?)_(dx|dy|ux|uy)$")
-
-
-def fit_front_speed(times, front, lo: float = 0.2, hi: float = 0.9, start: float | None = None,
-                    end: float | None = None) -> dict:
-    """Crack speed: least-squares line ``x = x0 + c t`` through the steady part of the front's travel.
-
-    The steady part is the samples with positions between ``start + lo (end - start)`` and
-    ``start + hi (end - start)``: this leaves out the saw phase and the start-up of the crack
-    (below) and its arrival at the end of the column (above). The line is fitted by
-    :func:`mpm_warp.fronts.steady_speed` (a repeated position keeps only its first time, so an
-    arrested front does not bias the slope; fewer than 3 points give NaN).
-
-    Parameters
-    ----------
-    times : array_like (n,)
-        Times [s].
-    front : array_like (n,)
-        Front position [m]; NaN where there is no front.
-    lo, hi : float
-        Window, as fractions of the path from ``start`` to ``end``, ``0 <= lo < hi <= 1``.
-    start, end : float, optional
-        Ends of the path [m]; default the first finite position and the largest (for a PST the
-        cut length and the column length).
-
-    Returns
-    -------
-    dict
-        ``speed`` [m/s], ``intercept`` [m] (position at t = 0), ``r2``, ``n_points``, ``window``
-        (positions fitted, [m]) and ``t_start``, ``t_end`` (times of the first and last point
-        fitted, [s]); NaN values when there is no steady part.
-    """
-    if not 0.0 <= lo < hi <= 1.0:
-        raise InvalidArgument("(lo, hi)", (lo, hi), "0 <= lo < hi <= 1")
-    t, x = np.asarray(times, dtype=float), np.asarray(front, dtype=float)
-    if t.shape != x.shape or t.ndim != 1:
-        raise InvalidArgument("front.shape", x.shape, f"the shape of times {t.shape}, one-dimensional")
-    ok = np.isfinite(t) & np.isfinite(x)
-    nan = float("nan")
-    if not ok.any():
-        return dict(speed=nan, intercept=nan, r2=nan, n_points=0, window=[nan, nan], t_start=nan, t_end=nan)
-    a = float(x[ok][0]) if start is None else float(start)
-    b = float(x[ok].max()) if end is None else float(end)
-    w_lo, w_hi = a + lo * (b - a), a + hi * (b - a)
-    fit = steady_speed(t[ok], x[ok], w_lo, w_hi)
-    inside = np.nonzero(ok & (x >= w_lo) & (x <= w_hi))[0]
-    t_used = t[inside[np.unique(x[inside], return_index=True)[1]]]     # as steady_speed: first time per position
-    return dict(speed=fit.speed, intercept=fit.intercept, r2=fit.r2, n_points=fit.n, window=[w_lo, w_hi],
-                t_start=float(t_used.min()) if t_used.size else nan, t_end=float(t_used.max()) if t_used.size else nan)
 
 
 def _figure(ncols: int = 1):
@@ -120,25 +71,16 @@ def _save(fig, out_dir: str, name: str, columns: dict, fit: dict | None = None) 
     return files
 
 
-def _front_name(run: RunData) -> str | None:
-    return next((n for n in ("front_position", "front") if n in run.scalars), None)
-
-
 def plot_front(run: RunData, out_dir: str) -> list[str]:
     """Front position against time with the fitted speed: ``front.png``, ``.csv``, ``.json``.
 
     The front is ``front_position`` (x [m]) or a PST's ``front`` (distance from the saw's end
-    [m]; with ``failure_front`` and ``saw`` beside it). For a PST the fit window is that of
-    :func:`mpm_warp.pst.analyze_pst_series`: 30 % to 85 % of the way from the cut to the far end.
+    [m]; with ``failure_front`` and ``saw`` beside it). The fit is :func:`mpm_warp.post.fronts.front_speed`
+    (for a PST the window of the PST's own result: 30 % to 85 % of the way from the cut to the far end).
     """
-    name = _front_name(run)
+    name = front_name(run)
     t, xf = run.times, run.scalars[name]
-    scene = (run.scenario or {}).get("scene") or {}
-    if name == "front" and scene.get("kind") == "pst" and "length" in scene:
-        cut = float((scene.get("saw") or {}).get("cut_length", 0.0))
-        fit = fit_front_speed(t, xf, 0.3, 0.85, start=cut, end=float(scene["length"]))
-    else:
-        fit = fit_front_speed(t, xf)
+    fit = front_speed(run)
     fig, (ax,) = _figure()
     ax.plot(t, xf, "o-", ms=3, lw=1, color="C0", label="crack front")
     columns = {"time [s]": t, f"{name} [{_unit(run, name)}]": xf}
@@ -249,7 +191,7 @@ def plot_run(path, out_dir=None) -> list[str]:
     out_dir = os.fspath(out_dir) if out_dir is not None else os.path.splitext(run.path)[0] + "_plots"
     os.makedirs(out_dir, exist_ok=True)
     s, files = run.scalars, []
-    if _front_name(run):
+    if front_name(run):
         files += plot_front(run, out_dir)
     if any(_MARKER.match(n) for n in s):
         files += plot_markers(run, out_dir)
@@ -258,20 +200,3 @@ def plot_run(path, out_dir=None) -> list[str]:
     if any(n.endswith("_energy") for n in s):
         files += plot_energy(run, out_dir)
     return files
-
-
-def _cmd_plot(a) -> int:
-    files = plot_run(a.run, a.out)
-    for f in files:
-        print(f)
-    if not files:
-        print("no plottable series in this run")
-    return 0
-
-
-def add_cli(subparsers) -> None:
-    """Add ``mpm-warp plot RUN.h5 [--out DIR]``."""
-    p = subparsers.add_parser("plot", help="plot a run's series (front speed, markers, shear test, energy)")
-    p.add_argument("run", help="HDF5 run file")
-    p.add_argument("--out", default=None, help="output folder (default: RUN_plots beside the run)")
-    p.set_defaults(func=_cmd_plot)

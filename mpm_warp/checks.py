@@ -1,8 +1,10 @@
-"""Small checks that turn bad input into :class:`InvalidArgument` naming the field."""
+"""Argument checks that turn bad input into :class:`InvalidArgument` naming the field, the value and the range."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import typing
 from collections.abc import Sequence
 
 import numpy as np
@@ -41,11 +43,6 @@ def vector(field: str, value, n: int = 3, *, nonzero: bool = False) -> tuple[flo
     return out
 
 
-def vector3(field: str, value, *, nonzero: bool = False) -> tuple[float, float, float]:
-    """Return ``value`` as a tuple of three finite floats."""
-    return vector(field, value, 3, nonzero=nonzero)
-
-
 def choice(field: str, value, allowed: Sequence[str]) -> str:
     """Check that ``value`` is one of ``allowed`` (strings)."""
     if value not in allowed:
@@ -60,3 +57,14 @@ def positive_int(field: str, value, *, lo: int = 1, hi: int | None = None) -> in
     if value < lo or (hi is not None and value > hi):
         raise InvalidArgument(field, value, f"an integer in [{lo}, {hi if hi is not None else 'inf'}]")
     return int(value)
+
+
+def check_choices(obj, where: str) -> None:
+    """Check every ``Literal``-typed field of the dataclass ``obj`` and of its nested dataclasses (:func:`choice`)."""
+    hints = typing.get_type_hints(type(obj))
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if typing.get_origin(hints[f.name]) is typing.Literal:
+            choice(f"{where}.{f.name}", value, typing.get_args(hints[f.name]))
+        elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+            check_choices(value, f"{where}.{f.name}")

@@ -1,4 +1,4 @@
-"""HDF5 run files and checkpoints of mpm_warp (NumPy and h5py only; no Warp).
+"""Writing HDF5 run files, frame by frame and crash-safe (NumPy and h5py only; no Warp).
 
 Run file layout (``format = "mpm_warp-run"``, ``format_version = 1``)::
 
@@ -38,98 +38,31 @@ protected: power loss (no fsync per frame), network file systems (no SWMR write 
 
 from __future__ import annotations
 
-import datetime
 import json
 import os
 
 import h5py
 import numpy as np
 
-from .errors import InvalidArgument, OutputError
+from ..errors import InvalidArgument, OutputError
+from .hdf5 import (
+    COMPRESSION,
+    FORMAT,
+    FORMAT_VERSION,
+    LIBVER,
+    RESERVED_ATTRS,
+    SERIES_CHUNK,
+    check_format,
+    check_name,
+    get_attrs,
+    layout,
+    now,
+    open_read,
+    series_datasets,
+    set_attrs,
+)
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "RunWriter", "RunData", "read_run",
-           "write_checkpoint", "read_checkpoint", "checkpoint_path_for"]
-
-FORMAT = "mpm_warp-run"
-FORMAT_VERSION = 1
-CHECKPOINT_FORMAT = "mpm_warp-checkpoint"
-_LIBVER = ("v110", "v110")
-_SERIES_CHUNK = 256                       # frames per chunk of the small per-frame series
-_RESERVED_ATTRS = {"format", "format_version", "created", "n_particles", "json_attrs"}
-_COMPRESSION = {"gzip": dict(compression="gzip", compression_opts=1, shuffle=True),
-                "lzf": dict(compression="lzf", shuffle=True), "none": {}}
-
-
-def _now() -> str:
-    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
-
-
-def _to_json(value) -> str:
-    def default(o):
-        if isinstance(o, (np.generic, np.ndarray)):
-            return o.tolist()
-        raise TypeError(f"{type(o).__name__} is not JSON serialisable")
-    return json.dumps(value, default=default)
-
-
-def _set_attrs(obj, attrs: dict) -> None:
-    """Store ``attrs`` on an HDF5 object; dicts, lists, tuples and None go as JSON text."""
-    as_json = set(json.loads(obj.attrs.get("json_attrs", "[]")))
-    for key, value in attrs.items():
-        is_json = isinstance(value, (dict, list, tuple)) or value is None
-        obj.attrs[key] = _to_json(value) if is_json else value
-        (as_json.add if is_json else as_json.discard)(key)
-    obj.attrs["json_attrs"] = json.dumps(sorted(as_json))
-
-
-def _get_attrs(obj) -> dict:
-    as_json = set(json.loads(obj.attrs.get("json_attrs", "[]")))
-    out = {k: json.loads(v) if k in as_json else v.item() if isinstance(v, np.generic) else v
-           for k, v in obj.attrs.items()}
-    out.pop("json_attrs", None)
-    return out
-
-
-def _open_read(path) -> h5py.File:
-    """Open a run or checkpoint read-only; ``swmr=True`` also opens files whose writer died."""
-    path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise OutputError(f"{path}: no such file")
-    try:
-        return h5py.File(path, "r", swmr=True)
-    except OSError as e:
-        raise OutputError(f"{path}: not a readable HDF5 file ({e})") from e
-
-
-def _check_format(f: h5py.File, expected: str) -> None:
-    fmt, version = f.attrs.get("format"), f.attrs.get("format_version")
-    if fmt != expected:
-        raise OutputError(f"{f.filename}: not an {expected} file (format attribute {fmt!r})")
-    if version is None or int(version) > FORMAT_VERSION:
-        raise OutputError(f"{f.filename}: format_version {version!r} is not supported "
-                          f"(this library reads up to {FORMAT_VERSION})")
-
-
-def _series(f: h5py.File) -> list[h5py.Dataset]:
-    """Every per-frame dataset, in the order they are written (``time`` last)."""
-    try:
-        out = [*f["particles"].values(), *f["scalars"].values()]
-        return out + ([f["walls/forces"]] if "walls/forces" in f else []) + [f["step"], f["time"]]
-    except KeyError as e:
-        raise OutputError(f"{f.filename}: incomplete run file ({e})") from e
-
-
-def _layout(f: h5py.File) -> tuple:
-    """``(n_particles, particle_fields, wall_names, scalar_series)`` of an open run file."""
-    return (int(f.attrs["n_particles"]),
-            {k: (d.shape[2:], d.dtype.str, d.attrs["unit"]) for k, d in f["particles"].items()},
-            json.loads(f["walls/forces"].attrs["names"]) if "walls/forces" in f else [],
-            {k: d.attrs["unit"] for k, d in f["scalars"].items()})
-
-
-def _check_name(kind: str, name: str) -> None:
-    if not isinstance(name, str) or not name or "/" in name or name in (".", "time", "step"):
-        raise InvalidArgument(kind, name, "a non-empty name without '/', not 'time' or 'step'")
+__all__ = ["RunWriter"]
 
 
 class RunWriter:
@@ -172,11 +105,11 @@ class RunWriter:
         self.path, self._f = os.fspath(path), None
         if not isinstance(n_particles, (int, np.integer)) or n_particles < 1:
             raise InvalidArgument("n_particles", n_particles, "an integer >= 1")
-        if compression not in _COMPRESSION:
-            raise InvalidArgument("compression", compression, f"one of {sorted(_COMPRESSION)}")
+        if compression not in COMPRESSION:
+            raise InvalidArgument("compression", compression, f"one of {sorted(COMPRESSION)}")
         self.n_particles, self._fields = int(n_particles), {}
         for name, spec in particle_fields.items():
-            _check_name("particle_fields", name)
+            check_name("particle_fields", name)
             try:
                 shape, dtype, unit = spec
                 self._fields[name] = (tuple(int(s) for s in shape), np.dtype(dtype), str(unit))
@@ -190,28 +123,28 @@ class RunWriter:
         self._scalars = {name: str(unit) for name, unit in (scalar_series or {}).items()}
         static = {}
         for name, (array, unit) in (static_fields or {}).items():
-            _check_name("static_fields", name)
+            check_name("static_fields", name)
             static[name] = (np.asarray(array), str(unit))
             if static[name][0].ndim < 1 or static[name][0].shape[0] != n_particles:
                 raise InvalidArgument(f"static_fields[{name!r}].shape", static[name][0].shape,
                                       f"({n_particles}, ...)")
         for name in self._scalars:
-            _check_name("scalar_series", name)
+            check_name("scalar_series", name)
         names = [*self._fields, *self._scalars, *static, "wall_forces"]
         if len(set(names)) < len(names):
             raise InvalidArgument("field names", names, "names unique across particle fields, "
                                   "scalars, static fields and 'wall_forces'")
         attrs = dict(attrs or {})
-        if _RESERVED_ATTRS & attrs.keys():
-            raise InvalidArgument("attrs keys", sorted(_RESERVED_ATTRS & attrs.keys()),
-                                  f"none of the reserved keys {sorted(_RESERVED_ATTRS)}")
+        if RESERVED_ATTRS & attrs.keys():
+            raise InvalidArgument("attrs keys", sorted(RESERVED_ATTRS & attrs.keys()),
+                                  f"none of the reserved keys {sorted(RESERVED_ATTRS)}")
         if append and os.path.exists(self.path):
             self._f = self._resume(keep_frames, attrs)
         else:
             if os.path.exists(self.path) and not overwrite:
                 raise OutputError(f"{self.path}: exists (pass overwrite=True to replace it)")
             self._f, self._n = self._build(static, attrs, compression), 0
-        self._datasets = {d.name.lstrip("/"): d for d in _series(self._f)}
+        self._datasets = {d.name.lstrip("/"): d for d in series_datasets(self._f)}
 
     @classmethod
     def reopen(cls, path, *, keep_frames: int | None = None, attrs: dict | None = None) -> RunWriter:
@@ -220,27 +153,27 @@ class RunWriter:
         The layout is read from the file; ``keep_frames`` complete frames are kept (all if
         None); ``attrs`` are added to the stored attributes.
         """
-        with _open_read(path) as f:
-            _check_format(f, FORMAT)
-            n_particles, fields, walls, scalars = _layout(f)
+        with open_read(path) as f:
+            check_format(f, FORMAT)
+            n_particles, fields, walls, scalars = layout(f)
         return cls(path, n_particles=n_particles, particle_fields=fields, wall_names=walls,
                    scalar_series=scalars, attrs=attrs, append=True, keep_frames=keep_frames)
 
     def _resume(self, keep_frames, attrs) -> h5py.File:
-        layout = (self.n_particles, {k: (s, d.str, u) for k, (s, d, u) in self._fields.items()},
-                  self.wall_names, self._scalars)
-        with _open_read(self.path) as src:
-            _check_format(src, FORMAT)
-            complete, found = min(d.shape[0] for d in _series(src)), _layout(src)
-            if found != layout:
+        expected = (self.n_particles, {k: (s, d.str, u) for k, (s, d, u) in self._fields.items()},
+                    self.wall_names, self._scalars)
+        with open_read(self.path) as src:
+            check_format(src, FORMAT)
+            complete, found = min(d.shape[0] for d in series_datasets(src)), layout(src)
+            if found != expected:
                 raise InvalidArgument("layout (n_particles, particle_fields, wall_names, "
-                                      "scalar_series)", layout, f"the layout of {self.path}: {found}")
+                                      "scalar_series)", expected, f"the layout of {self.path}: {found}")
             keep = complete if keep_frames is None else keep_frames
             if not isinstance(keep, (int, np.integer)) or not 0 <= keep <= complete:
                 raise InvalidArgument("keep_frames", keep_frames, f"an integer in [0, {complete}]")
-            old = _get_attrs(src)
-            resumed = old.pop("resumed", []) + [{"at": _now(), "kept_frames": int(keep)}]
-            attrs = {k: v for k, v in old.items() if k not in _RESERVED_ATTRS} | attrs
+            old = get_attrs(src)
+            resumed = old.pop("resumed", []) + [{"at": now(), "kept_frames": int(keep)}]
+            attrs = {k: v for k, v in old.items() if k not in RESERVED_ATTRS} | attrs
             static = {k: (d[()], d.attrs["unit"]) for k, d in src["static"].items()}
             first = next(iter(src["particles"].values()), None)
             compression = {"gzip": "gzip", "lzf": "lzf"}.get(getattr(first, "compression", 0), "none")
@@ -252,17 +185,17 @@ class RunWriter:
         """Write the file aside, with the first ``keep`` frames of ``src`` if given, switch it to
         SWMR mode and move it over ``path``: a kill leaves the old file or the new one."""
         part = self.path + ".part"
-        f = h5py.File(part, "w", libver=_LIBVER)
+        f = h5py.File(part, "w", libver=LIBVER)
         try:
             f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, n_particles=self.n_particles,
-                           created=src.attrs["created"] if src else _now())
+                           created=src.attrs["created"] if src else now())
             versions = {"h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
                         "numpy": np.__version__} | (attrs.get("versions") or {})
             units = {"length": "m", "time": "s", "mass": "kg", "force": "N", "energy": "J"}
-            _set_attrs(f, {**attrs, "versions": versions, "units": units | (attrs.get("units") or {})})
-            n, filt = self.n_particles, _COMPRESSION[compression]
+            set_attrs(f, {**attrs, "versions": versions, "units": units | (attrs.get("units") or {})})
+            n, filt = self.n_particles, COMPRESSION[compression]
 
-            def series(name, dtype, unit, shape=(), chunk=_SERIES_CHUNK, **kw):
+            def series(name, dtype, unit, shape=(), chunk=SERIES_CHUNK, **kw):
                 d = f.create_dataset(name, shape=(keep, *shape), maxshape=(None, *shape), dtype=dtype,
                                      chunks=(chunk, *shape), **kw)
                 d.attrs["unit"] = unit
@@ -382,140 +315,3 @@ class RunWriter:
     def __exit__(self, *exc) -> None:
         self.close()
 
-
-class RunData:
-    """Contents of a run file; small series are loaded, particle fields read on demand.
-
-    Attributes
-    ----------
-    path : str
-    attrs : dict
-        Root attributes, JSON-decoded where stored as JSON.
-    scenario : dict or None
-        The scenario, parsed from ``attrs["scenario"]`` (a dict, or JSON or TOML text).
-    n_frames, n_particles : int
-        Number of complete frames and of particles.
-    times, steps : ndarray (n_frames,)
-        Simulated time [s] and step of each frame.
-    particle_fields : list of str
-    static : dict of str -> ndarray (N, ...)
-    units : dict of str -> str
-        Unit of every dataset by name (``time``, ``step``, fields, scalars, ``wall_forces``).
-    wall_names : list of str
-    wall_forces : ndarray (n_frames, n_walls, 3)
-        Wall reaction forces [N].
-    scalars : dict of str -> ndarray (n_frames,)
-    """
-
-    def __init__(self, path):
-        self.path = os.fspath(path)
-        with _open_read(self.path) as f:
-            _check_format(f, FORMAT)
-            n = self.n_frames = min(d.shape[0] for d in _series(f))
-            self.attrs = _get_attrs(f)
-            self.n_particles = int(self.attrs["n_particles"])
-            self.times, self.steps = f["time"][:n], f["step"][:n]
-            self.particle_fields = list(f["particles"])
-            self.static = {k: d[()] for k, d in f["static"].items()}
-            self.scalars = {k: d[:n] for k, d in f["scalars"].items()}
-            self.units = {"time": "s", "step": "1"}
-            for group in ("particles", "static", "scalars"):
-                self.units.update({k: d.attrs["unit"] for k, d in f[group].items()})
-            self.wall_names, self.wall_forces = [], np.zeros((n, 0, 3))
-            if "walls/forces" in f:
-                self.wall_names = json.loads(f["walls/forces"].attrs["names"])
-                self.wall_forces, self.units["wall_forces"] = f["walls/forces"][:n], "N"
-
-    @property
-    def scenario(self) -> dict | None:
-        s = self.attrs.get("scenario")
-        if s is None or isinstance(s, dict):
-            return s
-        try:
-            return json.loads(s)
-        except ValueError:
-            try:
-                import tomllib
-            except ImportError:  # Python 3.10
-                import tomli as tomllib
-            return tomllib.loads(s)
-
-    def frame(self, i: int) -> dict[str, np.ndarray]:
-        """Particle fields of complete frame ``i`` (negative counts from the end)."""
-        if not -self.n_frames <= i < self.n_frames:
-            raise InvalidArgument("frame", i, f"an index in [{-self.n_frames}, {self.n_frames})")
-        with _open_read(self.path) as f:
-            return {k: f[f"particles/{k}"][i % self.n_frames] for k in self.particle_fields}
-
-    def field(self, name: str) -> np.ndarray:
-        """One particle field over all complete frames, ``(n_frames, N, *shape)``."""
-        if name not in self.particle_fields:
-            raise InvalidArgument("field", name, f"one of {self.particle_fields}")
-        with _open_read(self.path) as f:
-            return f[f"particles/{name}"][: self.n_frames]
-
-    def __repr__(self) -> str:
-        return (f"RunData({self.path!r}, n_frames={self.n_frames}, n_particles={self.n_particles}, "
-                f"fields={self.particle_fields})")
-
-
-def read_run(path) -> RunData:
-    """Read a run file (also one whose writer was killed); raises :class:`OutputError`."""
-    return RunData(path)
-
-
-def checkpoint_path_for(run_path) -> str:
-    """Checkpoint file of a run: ``run.h5`` -> ``run.ckpt.h5``."""
-    base, ext = os.path.splitext(os.fspath(run_path))
-    return (base if ext.lower() in (".h5", ".hdf5", ".hdf") else base + ext) + ".ckpt.h5"
-
-
-def _fsync(path: str) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-def write_checkpoint(path, arrays: dict[str, np.ndarray], meta: dict) -> None:
-    """Write the full state atomically: a temporary file, fsync, then ``os.replace``.
-
-    A process killed mid-write leaves the previous checkpoint intact.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-    arrays : dict of str -> ndarray
-        State arrays, stored uncompressed (speed) under their names ('/' makes groups).
-    meta : dict
-        JSON-serialisable description (step, time, frames written, scenario, ...).
-    """
-    path = os.fspath(path)
-    tmp = path + ".tmp"
-    try:
-        with h5py.File(tmp, "w") as f:
-            f.attrs.update(format=CHECKPOINT_FORMAT, format_version=FORMAT_VERSION, created=_now(),
-                           meta=_to_json(meta))
-            for name, a in arrays.items():
-                f.create_dataset(name, data=np.asarray(a))
-        _fsync(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
-    try:                                      # make the rename durable too
-        _fsync(os.path.dirname(os.path.abspath(path)))
-    except OSError:                           # directories cannot be fsynced everywhere
-        pass
-
-
-def read_checkpoint(path) -> tuple[dict[str, np.ndarray], dict]:
-    """Read a checkpoint: ``(arrays by name, meta)``; raises :class:`OutputError`."""
-    arrays = {}
-    with _open_read(path) as f:
-        _check_format(f, CHECKPOINT_FORMAT)
-        f.visititems(lambda name, obj: arrays.__setitem__(name, obj[()])
-                     if isinstance(obj, h5py.Dataset) else None)
-        return arrays, json.loads(f.attrs["meta"])

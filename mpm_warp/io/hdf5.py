@@ -1,0 +1,98 @@
+"""HDF5 helpers shared by run files and checkpoints: formats, attributes, safe opening (NumPy and h5py only)."""
+
+from __future__ import annotations
+
+import datetime
+import json
+import os
+
+import h5py
+import numpy as np
+
+from ..errors import InvalidArgument, OutputError
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "now", "to_json", "set_attrs", "get_attrs", "open_read",
+           "check_format", "series_datasets", "layout", "check_name", "LIBVER", "SERIES_CHUNK",
+           "RESERVED_ATTRS", "COMPRESSION"]
+
+FORMAT = "mpm_warp-run"
+FORMAT_VERSION = 1
+CHECKPOINT_FORMAT = "mpm_warp-checkpoint"
+LIBVER = ("v110", "v110")
+SERIES_CHUNK = 256                       # frames per chunk of the small per-frame series
+RESERVED_ATTRS = {"format", "format_version", "created", "n_particles", "json_attrs"}
+COMPRESSION = {"gzip": dict(compression="gzip", compression_opts=1, shuffle=True),
+                "lzf": dict(compression="lzf", shuffle=True), "none": {}}
+
+
+def now() -> str:
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+
+
+def to_json(value) -> str:
+    def default(o):
+        if isinstance(o, (np.generic, np.ndarray)):
+            return o.tolist()
+        raise TypeError(f"{type(o).__name__} is not JSON serialisable")
+    return json.dumps(value, default=default)
+
+
+def set_attrs(obj, attrs: dict) -> None:
+    """Store ``attrs`` on an HDF5 object; dicts, lists, tuples and None go as JSON text."""
+    as_json = set(json.loads(obj.attrs.get("json_attrs", "[]")))
+    for key, value in attrs.items():
+        is_json = isinstance(value, (dict, list, tuple)) or value is None
+        obj.attrs[key] = to_json(value) if is_json else value
+        (as_json.add if is_json else as_json.discard)(key)
+    obj.attrs["json_attrs"] = json.dumps(sorted(as_json))
+
+
+def get_attrs(obj) -> dict:
+    as_json = set(json.loads(obj.attrs.get("json_attrs", "[]")))
+    out = {k: json.loads(v) if k in as_json else v.item() if isinstance(v, np.generic) else v
+           for k, v in obj.attrs.items()}
+    out.pop("json_attrs", None)
+    return out
+
+
+def open_read(path) -> h5py.File:
+    """Open a run or checkpoint read-only; ``swmr=True`` also opens files whose writer died."""
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise OutputError(f"{path}: no such file")
+    try:
+        return h5py.File(path, "r", swmr=True)
+    except OSError as e:
+        raise OutputError(f"{path}: not a readable HDF5 file ({e})") from e
+
+
+def check_format(f: h5py.File, expected: str) -> None:
+    fmt, version = f.attrs.get("format"), f.attrs.get("format_version")
+    if fmt != expected:
+        raise OutputError(f"{f.filename}: not an {expected} file (format attribute {fmt!r})")
+    if version is None or int(version) > FORMAT_VERSION:
+        raise OutputError(f"{f.filename}: format_version {version!r} is not supported "
+                          f"(this library reads up to {FORMAT_VERSION})")
+
+
+def series_datasets(f: h5py.File) -> list[h5py.Dataset]:
+    """Every per-frame dataset, in the order they are written (``time`` last)."""
+    try:
+        out = [*f["particles"].values(), *f["scalars"].values()]
+        return out + ([f["walls/forces"]] if "walls/forces" in f else []) + [f["step"], f["time"]]
+    except KeyError as e:
+        raise OutputError(f"{f.filename}: incomplete run file ({e})") from e
+
+
+def layout(f: h5py.File) -> tuple:
+    """``(n_particles, particle_fields, wall_names, scalar_series)`` of an open run file."""
+    return (int(f.attrs["n_particles"]),
+            {k: (d.shape[2:], d.dtype.str, d.attrs["unit"]) for k, d in f["particles"].items()},
+            json.loads(f["walls/forces"].attrs["names"]) if "walls/forces" in f else [],
+            {k: d.attrs["unit"] for k, d in f["scalars"].items()})
+
+
+def check_name(kind: str, name: str) -> None:
+    if not isinstance(name, str) or not name or "/" in name or name in (".", "time", "step"):
+        raise InvalidArgument(kind, name, "a non-empty name without '/', not 'time' or 'step'")
+

@@ -1,0 +1,112 @@
+"""Crack fronts read from run files: the front as x per frame and the front-speed fit with the scene's window.
+
+The fit itself is :func:`mpm_warp.scenes.fronts.steady_speed` (its one home); a PST's window is
+:data:`mpm_warp.scenes.pst.PSTParams.SPEED_FIT_FRACTIONS` of the way from the cut to the far end,
+as the PST's own result uses.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InvalidArgument, MPMError
+from ..io import RunData
+from ..loader import scene_params_from_dict
+from ..scenes.fronts import fit_window, steady_speed
+from ..scenes.pst import PSTParams
+
+__all__ = ["scene_params", "front_name", "fit_front_speed", "front_speed", "front_and_saw_x"]
+
+
+def scene_params(run: RunData):
+    """The typed scene parameters of a run file (None without a scene, or when they cannot be read)."""
+    table = (run.scenario or {}).get("scene")
+    if not isinstance(table, dict) or table.get("kind", "blocks") == "blocks":
+        return None
+    try:
+        return scene_params_from_dict({k: v for k, v in table.items() if k != "derived"}, run.path)
+    except MPMError:                  # a file of another version: the generic analyses still work
+        return None
+
+
+def front_name(run: RunData) -> str | None:
+    """The run's front series: ``front_position`` (x, m) or a PST's ``front`` (m from the cut end), or None."""
+    return next((n for n in ("front_position", "front") if n in run.scalars), None)
+
+
+def fit_front_speed(times, front, lo: float = 0.2, hi: float = 0.9, start: float | None = None,
+                    end: float | None = None) -> dict:
+    """Crack speed: least-squares line ``x = x0 + c t`` through the steady part of the front's travel.
+
+    The steady part is the samples with positions between ``start + lo (end - start)`` and
+    ``start + hi (end - start)``: this leaves out the saw phase and the start-up of the crack
+    (below) and its arrival at the end of the column (above). The line is fitted by
+    :func:`mpm_warp.scenes.fronts.steady_speed` (a repeated position keeps only its first time, so an
+    arrested front does not bias the slope; fewer than 3 points give NaN).
+
+    Parameters
+    ----------
+    times : array_like (n,)
+        Times [s].
+    front : array_like (n,)
+        Front position [m]; NaN where there is no front.
+    lo, hi : float
+        Window, as fractions of the path from ``start`` to ``end``, ``0 <= lo < hi <= 1``.
+    start, end : float, optional
+        Ends of the path [m]; default the first finite position and the largest (for a PST the
+        cut length and the column length).
+
+    Returns
+    -------
+    dict
+        ``speed`` [m/s], ``intercept`` [m] (position at t = 0), ``r2``, ``n_points``, ``window``
+        (positions fitted, [m]) and ``t_start``, ``t_end`` (times of the first and last point
+        fitted, [s]); NaN values when there is no steady part.
+    """
+    if not 0.0 <= lo < hi <= 1.0:
+        raise InvalidArgument("(lo, hi)", (lo, hi), "0 <= lo < hi <= 1")
+    t, x = np.asarray(times, dtype=float), np.asarray(front, dtype=float)
+    if t.shape != x.shape or t.ndim != 1:
+        raise InvalidArgument("front.shape", x.shape, f"the shape of times {t.shape}, one-dimensional")
+    ok = np.isfinite(t) & np.isfinite(x)
+    nan = float("nan")
+    if not ok.any():
+        return dict(speed=nan, intercept=nan, r2=nan, n_points=0, window=[nan, nan], t_start=nan, t_end=nan)
+    a = float(x[ok][0]) if start is None else float(start)
+    b = float(x[ok].max()) if end is None else float(end)
+    w_lo, w_hi = fit_window(a, b, lo, hi)
+    fit = steady_speed(t, x, w_lo, w_hi)
+    return dict(speed=fit.speed, intercept=fit.intercept, r2=fit.r2, n_points=fit.n, window=[w_lo, w_hi],
+                t_start=fit.t_start, t_end=fit.t_end)
+
+
+def front_speed(run: RunData) -> dict:
+    """:func:`fit_front_speed` of the run's front series, with a PST's window for a PST (see module docstring)."""
+    name = front_name(run)
+    if name is None:
+        raise InvalidArgument("run", run.path, "a run with a front series (front_position or a PST's front)")
+    t, xf = run.times, run.scalars[name]
+    params = scene_params(run)
+    if name == "front" and isinstance(params, PSTParams):
+        return fit_front_speed(t, xf, *PSTParams.SPEED_FIT_FRACTIONS, start=float(params.saw.cut_length),
+                               end=float(params.length))
+    return fit_front_speed(t, xf)
+
+
+def front_and_saw_x(run: RunData) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Crack front and saw blade as x [m] per frame, NaN where there is none.
+
+    ``front_position`` / ``saw_position`` are x already; a PST's ``front`` / ``saw`` are distances from
+    the saw's starting end (``saw.from_end``), 0 before there is any.
+    """
+    params = scene_params(run)
+    out = []
+    for x_name, s_name in (("front_position", "front"), ("saw_position", "saw")):
+        if x_name in run.scalars:
+            out.append(run.scalars[x_name])
+        elif s_name in run.scalars:
+            s = np.where(run.scalars[s_name] > 0, run.scalars[s_name], np.nan)
+            out.append(params.distance_from_cut_end(s) if isinstance(params, PSTParams) else s)
+        else:
+            out.append(None)
+    return out[0], out[1]

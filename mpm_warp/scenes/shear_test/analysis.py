@@ -1,0 +1,133 @@
+"""Results of a shear test from its frame series (pure NumPy): peak, residual, softening, collapse (SI Note 2)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .params import ShearTestParams
+
+__all__ = ["ShearSummary", "shear_summary", "shear_curves", "analyze_shear_series"]
+
+
+def shear_curves(params: ShearTestParams, times, series: dict) -> dict[str, np.ndarray]:
+    """Curves of the pushing phase: ``u`` (m), ``gamma``, ``tau`` (Pa), ``q`` (Pa), ``axial`` (-), ``t`` (s).
+
+    Displacements are taken relative to the state when the push starts;
+    ``axial`` is the thickness loss over ``D_wl`` (positive = compaction).
+    """
+    t = np.asarray(times, dtype=float)
+    i0 = min(int(np.searchsorted(t, params.push_start - 1e-12)), len(t) - 1)
+    d_wl = float(params.weak_layer_thickness)
+    u = np.asarray(series["shear_displacement"], dtype=float)[i0:]
+    v = np.asarray(series["normal_displacement"], dtype=float)[i0:]
+    u = u - u[0]
+    return {"t": t[i0:], "u": u, "gamma": u / d_wl, "tau": np.asarray(series["shear_stress"], dtype=float)[i0:],
+            "q": np.asarray(series["mises_q"], dtype=float)[i0:], "axial": -(v - v[0]) / d_wl}
+
+
+def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
+    """Peak and residual strength, softening displacement and collapse (:func:`shear_summary`) with references."""
+    c = shear_curves(params, times, series)
+    if len(c["u"]) < 3:
+        return {}
+    sm = shear_summary(c["u"], c["tau"], c["axial"])
+    refs = params.references()
+    return {"peak_shear_stress": sm.peak_stress, "residual_shear_stress": sm.residual_stress,
+            "peak_displacement": sm.peak_displacement, "softening_displacement": sm.softening_displacement,
+            "drop_displacement": sm.drop_displacement,
+            "collapse_fraction": sm.collapse_fraction, "peak_q": float(np.max(c["q"])),
+            "sigma_n": float(refs["sigma_n"]), "collapse_fraction_law": float(refs["collapse_fraction_law"])}
+
+
+@dataclass(frozen=True)
+class ShearSummary:
+    """Shear test results (SI Note 2).
+
+    Attributes
+    ----------
+    peak_stress, residual_stress : float
+        Peak (intact) and residual shear stress (Pa). The peak is the maximum before the
+        stress first falls below half of its running maximum (the failure); the residual
+        may exceed it when the collapsed layer hardens.
+    peak_displacement : float
+        Shear displacement at the peak (m).
+    softening_displacement : float
+        Critical sliding displacement (m): from the peak to the end of the softening
+        zone, the first point where the stress is within ``(1 - drop) max(peak - residual,
+        residual - minimum)`` of the residual, searched after the post-peak minimum when
+        the stress undershoots the residual (the layer slides at a low stress while it
+        collapses, then recovers to the residual friction); nan if never.
+    drop_displacement : float
+        Displacement (m) from the peak to the first point where the stress has fallen
+        by ``drop`` of ``peak - residual`` (how abrupt the loss of strength is); nan if never.
+    collapse_fraction : float
+        Final weak-layer thickness change over its thickness (-), positive for compaction.
+    peak_index, softened_index : int
+        Sample indices of the peak and of the end of softening (-1 if none).
+    """
+
+    peak_stress: float
+    residual_stress: float
+    peak_displacement: float
+    softening_displacement: float
+    drop_displacement: float
+    collapse_fraction: float
+    peak_index: int
+    softened_index: int
+
+
+def _crossing(u, tau, ip: int, cond) -> tuple[int, float]:
+    """First index after ``ip`` where ``cond(tau)`` holds and the displacement from the peak there."""
+    idx = np.nonzero((np.arange(len(u)) > ip) & cond(tau))[0]
+    if idx.size == 0:
+        return -1, math.nan
+    j = int(idx[0])
+    return j, float(u[j] - u[ip])
+
+
+def shear_summary(u, tau, axial, residual_window: float = 0.2, drop: float = 0.9) -> ShearSummary:
+    """Peak, residual, softening displacement and collapse from shear-test curves.
+
+    Parameters
+    ----------
+    u : array
+        Shear (sliding) displacement of the loaded top relative to the base (m), increasing.
+    tau : array
+        Shear stress (Pa).
+    axial : array
+        Weak-layer thickness change over its thickness (-), positive for compaction.
+    residual_window : float
+        The residual stress is the mean over the last ``residual_window`` of the displacement range.
+    drop : float
+        Fraction of ``peak - residual`` defining the end of the stress drop and, as its
+        complement, the band around the residual that ends the softening zone.
+    """
+    u = np.asarray(u, dtype=float)
+    tau = np.asarray(tau, dtype=float)
+    axial = np.asarray(axial, dtype=float)
+    # the peak is the intact layer's strength: the maximum before the first failure, i.e. before
+    # the stress first falls below half its running maximum (a collapsed layer may later harden
+    # to a frictional strength above it); without such a drop, the global maximum
+    run_max = np.maximum.accumulate(tau)
+    fail = np.nonzero((run_max > 0) & (tau < 0.5 * run_max))[0]
+    ip = int(np.argmax(tau[: fail[0]])) if fail.size else int(np.argmax(tau))
+    tp = float(tau[ip])
+    u_end = float(u[-1])
+    tail = u >= u_end - residual_window * (u_end - float(u[0]))
+    tail &= np.arange(len(u)) > ip
+    tr = float(np.mean(tau[tail])) if tail.any() else float(tau[-1])
+    delta = tp - tr
+    if ip + 1 < len(tau) and (delta > 0 or float(np.min(tau[ip + 1:])) < 0.5 * tp):
+        lowest = min(tr, float(np.min(tau[ip + 1:])))
+        _, d_drop = _crossing(u, tau, ip, lambda x: x <= tp - drop * (tp - lowest))
+        jmin = ip + 1 + int(np.argmin(tau[ip + 1:]))
+        band = (1.0 - drop) * max(delta, tr - float(tau[jmin]))
+        start = jmin if tau[jmin] < tr - band else ip
+        js, _ = _crossing(u, tau, start, lambda x: np.abs(x - tr) <= band)
+        d_soft = float(u[js] - u[ip]) if js >= 0 else math.nan
+    else:
+        d_drop, js, d_soft = math.nan, -1, math.nan
+    return ShearSummary(tp, tr, float(u[ip]), d_soft, d_drop, float(axial[-1]), ip, js)

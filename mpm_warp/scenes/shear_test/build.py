@@ -1,0 +1,32 @@
+"""Building a shear-test scenario from its parameters: the sample, the loading block, the sticky substratum."""
+
+from __future__ import annotations
+
+from ...config import Block, Output, Scenario, TimeControl
+from ...materials import Elastic
+from ...walls import Wall
+from ..snow import GRAVITY, plane_domain, settle_time
+from .params import ShearTestParams
+
+__all__ = ["build"]
+
+
+def build(params: ShearTestParams, time: TimeControl, output: Output | None = None, *, name: str = "shear_test",
+          precision: str = "float32", description: str = "") -> Scenario:
+    """The scenario of a shear test (parameters as :func:`mpm_warp.scenes.pst.build`; gravity is vertical)."""
+    p = params.validate()
+    dx, Ls, d_wl, t_load = p.dx, p.sample_length, p.weak_layer_thickness, p.load_thickness
+    sigma_n = p.sigma_n
+    m = p.margin_cells
+    domain, wz = plane_domain((-m, 0.0), (Ls + m, d_wl + t_load + m), dx, p.width, m)
+    materials = {"load": Elastic(p.slab.E, p.slab.nu, p.load_density),
+                 "weak_layer": p.weak_layer.material(sigma_n)}
+    ppc = p.particles_per_cell
+    blocks = (Block("weak_layer", (0.0, 0.0, 0.0), (Ls, d_wl, wz), particles_per_cell=ppc, name="weak_layer"),
+              Block("load", (0.0, d_wl, 0.0), (Ls, d_wl + t_load, wz), particles_per_cell=ppc, name="load"))
+    floor = Wall((0.0, 0.0, 0.0), (0.0, 1.0, 0.0), kind="sticky", name="substratum")
+    desc = description or (f"Shear test: {Ls * 100:g} cm x {d_wl * 100:g} cm weak layer under {sigma_n:.0f} Pa, "
+                           f"wall at {p.wall_speed:g} m/s")
+    return Scenario(name=name, domain=domain, time=settle_time(time, p.settle, (0.0, -GRAVITY, 0.0)),
+                    materials=materials, blocks=blocks, walls=(floor,), output=output or Output(),
+                    precision=precision, description=desc, scene=p)

@@ -1,0 +1,127 @@
+"""Shared pieces of the snow scenes: slab, settling, the slab's load, the plane-strain box.
+
+Both snow scenes put a weak layer (:mod:`mpm_warp.scenes.weak_layer`) on a substratum at ``y = 0``
+under a load, settle it under ramped gravity and grid damping, then run the experiment. ``x`` runs
+along the column, ``y`` is normal to the bed, ``z`` across; a slope of angle ``theta`` is a rotated
+gravity ``g (sin theta, -cos theta, 0)`` (downslope is ``+x``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from ..checks import finite_number
+from ..config import Domain, TimeControl
+from ..errors import InvalidArgument
+from ..materials import Elastic
+
+__all__ = ["GRAVITY", "Slab", "Settle", "SETTLE_TIME_KEYS", "MIN_WEAK_LAYER_CELLS", "slab_normal_stress",
+           "oedometric_pressure", "slope_gravity", "settle_time", "plane_domain", "check_weak_layer_cells"]
+
+GRAVITY = 9.81
+"""Gravitational acceleration (m/s^2)."""
+
+#: the weak layer must span at least this many grid cells: thinner, the slab's B-spline stencil
+#: reaches the substratum's wall nodes and the slab rests partly on the wall through the grid
+MIN_WEAK_LAYER_CELLS = 2.0
+#: ``[time]`` keys a snow scene sets itself (from its slope and :class:`Settle`)
+SETTLE_TIME_KEYS = ("gravity", "gravity_ramp", "damping", "damping_until")
+
+
+@dataclass(frozen=True)
+class Slab:
+    """The elastic slab.
+
+    Attributes
+    ----------
+    E : float
+        Young's modulus (Pa), > 0.
+    nu : float
+        Poisson's ratio (-), in [0, 0.5).
+    density : float
+        Density (kg/m^3), > 0.
+    """
+
+    E: float = 5.0e6
+    nu: float = 0.3
+    density: float = 250.0
+
+    def material(self) -> Elastic:
+        """The slab's elastic material (checked, naming ``where`` in errors)."""
+        return Elastic(self.E, self.nu, self.density)
+
+    def validate(self, where: str = "slab") -> Slab:
+        """Check every value; return self."""
+        self.material().validate(where)
+        return self
+
+
+@dataclass(frozen=True)
+class Settle:
+    """Settling before the experiment: gravity ramps up while the grid is damped.
+
+    Attributes
+    ----------
+    gravity_ramp : float
+        Gravity grows linearly from 0 over this time (s), >= 0.
+    damping : float
+        Grid velocity damping rate while settling (1/s), >= 0.
+    duration : float
+        End of settling (s), >= ``gravity_ramp``: the experiment (saw, push) starts then.
+    """
+
+    gravity_ramp: float = 0.05
+    damping: float = 100.0
+    duration: float = 0.1
+
+    def validate(self, where: str = "settle") -> Settle:
+        """Check every value; return self."""
+        ramp = finite_number(f"{where}.gravity_ramp", self.gravity_ramp, lo=0.0)
+        finite_number(f"{where}.damping", self.damping, lo=0.0)
+        dur = finite_number(f"{where}.duration", self.duration, lo=0.0)
+        if dur < ramp:
+            raise InvalidArgument(f"{where}.duration", self.duration, f"a time >= {where}.gravity_ramp = {ramp:g} s")
+        return self
+
+
+def slab_normal_stress(density: float, thickness: float, slope_deg: float = 0.0) -> float:
+    """Bed-normal stress of the slab's weight, ``rho g D cos(theta)`` (Pa)."""
+    return density * GRAVITY * thickness * math.cos(math.radians(slope_deg))
+
+
+def oedometric_pressure(sigma_n: float, nu: float) -> float:
+    """Mean pressure (Pa) under a bed-normal stress ``sigma_n`` with no lateral strain.
+
+    Lateral stresses ``nu/(1-nu) sigma_n``: ``p = sigma_n (1 + nu) / (3 (1 - nu))``.
+    """
+    return sigma_n * (1.0 + nu) / (3.0 * (1.0 - nu))
+
+
+def slope_gravity(slope_deg: float) -> tuple[float, float, float]:
+    """Gravity (m/s^2) on a slope of ``slope_deg``: ``g (sin theta, -cos theta, 0)``, downslope ``+x``."""
+    th = math.radians(slope_deg)
+    return (GRAVITY * math.sin(th), -GRAVITY * math.cos(th), 0.0)
+
+
+def settle_time(time: TimeControl, settle: Settle, gravity) -> TimeControl:
+    """``time`` with the scene's gravity and the settling ramp and damping (:data:`SETTLE_TIME_KEYS`)."""
+    return replace(time, gravity=tuple(gravity), gravity_ramp=float(settle.gravity_ramp),
+                   damping=float(settle.damping), damping_until=float(settle.duration))
+
+
+def plane_domain(lo_xy, hi_xy, dx: float, width: float, margin: float) -> tuple[Domain, float]:
+    """Domain and z extent (m): one cell between slip walls (``width = 0``, plane strain) or a free 3D column."""
+    if width <= 0.0:
+        return Domain((lo_xy[0], lo_xy[1], 0.0), (hi_xy[0], hi_xy[1], dx), dx, boundary="slip",
+                      boundary_faces="z"), dx
+    return Domain((lo_xy[0], lo_xy[1], -margin), (hi_xy[0], hi_xy[1], width + margin), dx, boundary="none"), width
+
+
+def check_weak_layer_cells(d_wl: float, dx: float, where: str) -> None:
+    """Raise if the weak layer spans fewer than :data:`MIN_WEAK_LAYER_CELLS` grid cells."""
+    if d_wl < MIN_WEAK_LAYER_CELLS * dx * (1.0 - 1e-9):
+        raise InvalidArgument(
+            f"{where}.weak_layer_thickness", d_wl,
+            f"at least {MIN_WEAK_LAYER_CELLS:g} cells of {where}.dx = {dx:g} m (it spans {d_wl / dx:.2g} cells; "
+            "thinner, the slab's stencil reaches the substratum wall through the grid): lower dx or thicken the layer")

@@ -1,0 +1,3 @@
+"""The version of mpm_warp."""
+
+__version__ = "0.1.0"
