@@ -37,7 +37,7 @@ the CPU in seconds, as ``tests/test_device_suite.py`` does in CI):
     after every configuration).
 ``pst``
     One production-resolution flat PST (:func:`run_pst_flat`, the one place
-    that knows how to run it).
+    that knows how to run it), with its wall time per simulated second.
 """
 
 from __future__ import annotations
@@ -265,26 +265,25 @@ def part_throughput(device: str, quick: bool, deadline: float, out_dir: str) -> 
 def run_pst_flat(device: str, quick: bool):
     """The production-resolution flat PST: the one place that knows how to run it.
 
-    Today ``scenarios/pst_flat.toml`` (dx = 1 cm, 208k particles, 0.35 s) through
-    ``mpm_warp.pst.run_pst``; quick mode runs a 1 m column for 2 ms. Returns
-    ``(RunResult, monitor)``.
+    Today the ready scene ``pst_flat`` (``scenarios/pst_flat.toml``: dx = 1 cm, 0.35 s) through
+    ``mpm_warp.run``; quick mode runs a 1 m column for 2 ms. Returns the ``RunResult``.
     """
-    from mpm_warp.pst import run_pst
+    import mpm_warp
 
     overrides = ["scene.length=1.0", "time.end=0.002", "time.frame_interval=0.001"] if quick else None
-    return run_pst("pst_flat", device=device, overrides=overrides)
+    return mpm_warp.run("pst_flat", device=device, overrides=overrides)
 
 
 def part_pst(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
-    """Run :func:`run_pst_flat` and record its cost and its crack diagnostics."""
+    """Run :func:`run_pst_flat` and record its cost and the scene's results (crack speed, ...)."""
     t0 = time.perf_counter()
-    res, _ = run_pst_flat(device, quick)
+    res = run_pst_flat(device, quick)
     total = time.perf_counter() - t0
-    extra = {k: v for k, v in res.extra.items() if isinstance(v, (int, float, str, bool)) or v is None}
+    scene = {k: v for k, v in res.scene_result.items() if isinstance(v, (int, float, str, bool)) or v is None}
     return {"device": res.device, "n_particles": res.n_particles, "steps": res.steps, "sim_time_s": res.sim_time,
             "stepping_wall_s": res.wall_time, "total_wall_s": total, "particle_steps_per_s": res.particle_steps_per_s,
             "wall_s_per_simulated_s": res.wall_time / res.sim_time if res.sim_time > 0 else None,
-            "edge_hits": res.edge_hits, "extra": extra}
+            "edge_hits": res.edge_hits, "scene_result": scene}
 
 
 PART_FUNCS = {"tests": part_tests, "graph": part_graph,
