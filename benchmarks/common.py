@@ -95,6 +95,7 @@ def environment(device: str) -> dict:
         "cuda_driver": _version_str(wp.get_cuda_driver_version()) if dev is not None and dev.is_cuda else None,
         "cuda_toolkit": _version_str(wp.get_cuda_toolkit_version()) if dev is not None and dev.is_cuda else None,
         "load_average_1_5_15_min": list(os.getloadavg()),
+        "git_commit": _git_commit(),
         "cpu": platform.processor() or platform.machine(),
         "cpu_count": os.cpu_count(),
         "python": platform.python_version(),
@@ -110,6 +111,22 @@ def environment(device: str) -> dict:
     except Exception:  # noqa: BLE001 - optional
         env["taichi"] = None
     return env
+
+
+def _git_commit() -> str | None:
+    """The checkout's commit (with ``+dirty`` when it has uncommitted changes), None outside git."""
+    import subprocess
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    try:
+        head = subprocess.run(["git", "-C", root, "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
+        dirty = subprocess.run(["git", "-C", root, "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    if head.returncode != 0:
+        return None
+    return head.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
 
 
 def _version_str(v) -> str | None:
