@@ -54,28 +54,39 @@ def time_steps(sim: mpm_warp.Simulation, steps: int, repeats: int = 3, warmup: i
     return out
 
 
+def clock_for(device: str):
+    """The timer of a benchmark on ``device``: process CPU time on the CPU, wall time on CUDA.
+
+    The development CPU's two cores are shared with other work; a one-thread
+    launch's CPU time is its own work, while its wall time grows with the
+    other users' load. On CUDA the host only waits, so wall time it is.
+    """
+    return time.perf_counter if wp.get_device(device).is_cuda else time.process_time
+
+
 def stage_times(sim: mpm_warp.Simulation, steps: int = 10) -> dict[str, float]:
-    """Median seconds per step of each stage, launched one stage at a time (one thread)."""
+    """Median seconds per step of each stage, launched one stage at a time (one thread; CPU time on the CPU)."""
     st = sim.stepper
     st.set_frame_end(1e9)
     acc = {"p2g": [], "grid_update": [], "g2p": []}
     dev = sim.device
+    clock = clock_for(dev)
     for _ in range(steps):
         st._begin.launch()
         wp.synchronize_device(dev)
-        t0 = time.perf_counter()
+        t0 = clock()
         for k in range(st.n_threads):
             st._scatter(k)
         wp.synchronize_device(dev)
-        t1 = time.perf_counter()
+        t1 = clock()
         for g in st._grid:
             g.launch()
         wp.synchronize_device(dev)
-        t2 = time.perf_counter()
+        t2 = clock()
         for g in st._g2p:
             g.launch()
         wp.synchronize_device(dev)
-        t3 = time.perf_counter()
+        t3 = clock()
         st._end.launch()
         acc["p2g"].append(t1 - t0)
         acc["grid_update"].append(t2 - t1)

@@ -48,8 +48,9 @@ def compare_size(dim: int, n_grid: int, steps: int, threads: int, device: str, r
     sim.stepper.steps(w["warmup"])
     cost = update_cost(sim)
     w["update_parts_s_per_step"] = cost
+    step = w["s_per_step"] if device.startswith("cuda") else w["cpu_s_per_step"]  # same clock as update_cost
     for part in ("update", "series_check", "principal", "return"):
-        w[f"{part}_share"] = cost[f"{part}_s"] / w["s_per_step"]
+        w[f"{part}_share"] = cost[f"{part}_s"] / step
     out = {"dim": dim, "n_grid": n_grid, "n_particles": w["n_particles"], "threads": threads, "mpm_warp": w}
     print(f"mpm_warp {dim}D N {w['n_particles']:7d} threads {w['threads']}: {w['particle_steps_per_s'] / 1e6:6.3f} "
           f"M particle-steps/s; plasticity {w['plasticity_share']:.2f} of the step; alone: update "

@@ -103,7 +103,8 @@ def run_taichi_block(n_grid: int, steps: int, arch: str = "cpu", cpu_max_num_thr
         Cam-Clay: per-step return kinds of the timed steps (replayed with yield tracking).
     return_share : bool
         Cam-Clay: also time the same steps with the return compiled out
-        (``no_return_s_per_step``; ``return_share = 1 - that / median``).
+        (``no_return_s_per_step``; ``return_share = 1 - that / this``, from
+        process CPU time on the CPU).
 
     Returns
     -------
@@ -183,10 +184,15 @@ def run_taichi_block(n_grid: int, steps: int, arch: str = "cpu", cpu_max_num_thr
         result["com_y_after"] = com_y
         result["com_y_expected"] = expected_com_y(W + steps)
         finite = math.isfinite(com_y)
+    result["cpu_s_per_step"] = statistics.median(cpu_times) / steps
     if return_share and plastic:
-        t_nr, _ = _time_kernel(ti, scene, scene.substep(scatter, "no_return"), snap, steps, repeats)
+        t_nr, c_nr = _time_kernel(ti, scene, scene.substep(scatter, "no_return"), snap, steps, repeats)
         result["no_return_s_per_step"] = statistics.median(t_nr) / steps
-        result["return_share"] = 1.0 - result["no_return_s_per_step"] / median_step
+        result["no_return_cpu_s_per_step"] = statistics.median(c_nr) / steps
+        if on_cpu:  # CPU time on the (shared) CPU, one thread
+            result["return_share"] = 1.0 - result["no_return_cpu_s_per_step"] / result["cpu_s_per_step"]
+        else:
+            result["return_share"] = 1.0 - result["no_return_s_per_step"] / median_step
     if diagnostics and plastic:
         scene.restore(snap)
         kernel = scene.substep(scatter, "plastic_track")

@@ -79,10 +79,10 @@ def default_warmup(material: str, n_grid: int) -> int:
 
 
 def _timed(sim: mpm_warp.Simulation, snap: dict, steps: int, repeats: int) -> tuple[list[float], list[float]]:
-    """Seconds per step of ``repeats`` batches of ``steps`` steps, each from the snapshot, and the process
-    CPU time over the wall time of each (well below the thread count: the cores were shared)."""
+    """Wall seconds and process CPU seconds per step of ``repeats`` batches of ``steps`` steps, each from the
+    snapshot (CPU time below wall time times the thread count: the cores were shared)."""
     st = sim.stepper
-    out, util = [], []
+    wall, cpu = [], []
     for _ in range(repeats):
         sim.state.load_arrays(snap)
         st.set_frame_end(1e9)
@@ -91,10 +91,9 @@ def _timed(sim: mpm_warp.Simulation, snap: dict, steps: int, repeats: int) -> tu
         t0 = time.perf_counter()
         st.steps(steps)
         wp.synchronize_device(sim.device)
-        wall = time.perf_counter() - t0
-        out.append(wall / steps)
-        util.append((time.process_time() - c0) / wall)
-    return out, util
+        wall.append((time.perf_counter() - t0) / steps)
+        cpu.append((time.process_time() - c0) / steps)
+    return wall, cpu
 
 
 def return_kinds_per_step(dim: int, n_grid: int, snap: dict, steps: int, device: str, n_threads: int | None):
@@ -125,16 +124,17 @@ def run_block(dim: int, material: str, n_grid: int, steps: int, device: str = "c
     dict
         ``engine``, ``dim``, ``material``, ``n_grid``, ``n_particles``,
         ``threads``, ``warmup``, ``steps``, ``dt``, ``s_per_step`` (median),
-        ``times_s_per_step``, ``cpu_utilisation`` (median process CPU time over
-        wall time; on the CPU well below ``threads`` means the cores were
-        shared), ``particle_steps_per_s``, ``bytes_per_particle``
+        ``times_s_per_step``, ``cpu_s_per_step`` (median process CPU time per
+        step), ``cpu_utilisation`` (median CPU time over wall time; on the CPU
+        well below ``threads`` means the cores were shared),
+        ``particle_steps_per_s``, ``bytes_per_particle``
         (particle state), ``grid_bytes_per_particle`` (all grid copies), and
         ``com_y`` (elastic) or ``observables`` (Cam-Clay, see
         ``plastic_block.observables``); with ``stages`` the per-stage seconds
         per step (one thread), with ``diagnostics`` ``return_kinds`` per timed
         step and ``return_kind_problems``, with ``return_share`` the same
-        steps with plasticity compiled out (``no_plasticity_s_per_step``) and
-        ``plasticity_share = 1 - that / s_per_step``.
+        steps with plasticity compiled out (``no_plasticity_s_per_step``, and
+        its CPU time) and ``plasticity_share = 1 - that / this`` (CPU times on the CPU).
     """
     sim = block_simulation(dim, material, n_grid, device, n_threads)
     W = default_warmup(material, n_grid) if warmup is None else warmup
@@ -143,13 +143,14 @@ def run_block(dim: int, material: str, n_grid: int, steps: int, device: str = "c
     st.steps(W)  # compiles every kernel of the plan
     wp.synchronize_device(sim.device)
     snap = {k: np.array(a, copy=True) for k, a in sim.state.arrays().items()}  # on the CPU .numpy() is a view
-    ts, util = _timed(sim, snap, steps, repeats)
+    ts, cpu = _timed(sim, snap, steps, repeats)
     med = statistics.median(ts)
     N = sim.model.n_particles
     row = {"engine": "mpm_warp", "dim": dim, "material": material, "n_grid": n_grid, "n_particles": N,
            "threads": st.n_threads, "device": sim.device, "warmup": W, "steps": steps,
            "dt": float(sim.scenario.time.dt), "s_per_step": med, "times_s_per_step": ts,
-           "cpu_utilisation": statistics.median(util),
+           "cpu_s_per_step": statistics.median(cpu),
+           "cpu_utilisation": statistics.median(c / w for c, w in zip(cpu, ts, strict=True)),
            "particle_steps_per_s": N / med, "bytes_per_particle": sim.model.bytes_per_particle(sim.state),
            "grid_bytes_per_particle": (st.grid_m_all.capacity + st.grid_p_all.capacity) / N}
     if material == "plastic":
@@ -168,7 +169,10 @@ def run_block(dim: int, material: str, n_grid: int, steps: int, device: str = "c
         twin_snap = {k: v for k, v in snap.items() if k != "log_jp"}
         twin.stepper.set_frame_end(1e9)
         twin.stepper.steps(1)  # compile
-        t_el = statistics.median(_timed(twin, twin_snap, steps, repeats)[0])
-        row["no_plasticity_s_per_step"] = t_el
-        row["plasticity_share"] = 1.0 - t_el / med
+        wall_el, cpu_el = _timed(twin, twin_snap, steps, repeats)
+        row["no_plasticity_s_per_step"] = statistics.median(wall_el)
+        row["no_plasticity_cpu_s_per_step"] = statistics.median(cpu_el)
+        on_cpu = not wp.get_device(sim.device).is_cuda  # shares from CPU time on the (shared) CPU
+        row["plasticity_share"] = (1.0 - row["no_plasticity_cpu_s_per_step"] / row["cpu_s_per_step"] if on_cpu
+                                   else 1.0 - row["no_plasticity_s_per_step"] / med)
     return row
