@@ -73,6 +73,8 @@ def stage_times(sim: mpm_warp.Simulation, steps: int = 10) -> dict[str, float]:
     clock = clock_for(dev)
     for _ in range(steps):
         st._begin.launch()
+        if getattr(st, "_wall_state", None) is not None:
+            st._wall_state.launch()
         wp.synchronize_device(dev)
         t0 = clock()
         for k in range(st.n_threads):

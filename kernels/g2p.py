@@ -3,6 +3,9 @@
 ``v_p = sum_i w_ip v_i``, ``C_p = D^-1 sum_i w_ip v_i (x_i - x_p)^T`` with
 ``D^-1 = 4 / dx^2`` for quadratic B-splines, ``x_p += dt v_p``.
 
+The grid velocity is read from the flat layout of ``kernels/p2g.py`` (node
+``(i, j[, k])`` at ``i s_0 + j s_1 [+ k]``).
+
 Edge policy: a particle whose new position leaves the safe interior of the
 grid (where its stencil still fits) is clamped to it and counted in
 ``counts[0]``; the driver reports the count. A particle whose stencil is not
@@ -33,12 +36,13 @@ def g2p_kernel(dim, T):
         x: wp.array(dtype=V),
         v: wp.array(dtype=V),
         C: wp.array(dtype=M),
-        grid_v: wp.array(dtype=V, ndim=dim),
+        grid_v: wp.array(dtype=V),
         dt_arr: wp.array(dtype=T),
         origin: V,
         inv_dx: T,
         dx: T,
         shape: Vi,
+        strides: Vi,
         x_lo: V,
         x_hi: V,
         counts: wp.array(dtype=wp.int32),
@@ -54,18 +58,21 @@ def g2p_kernel(dim, T):
             return
         vn = V()
         B = M()
+        n0 = b[0] * strides[0] + b[1] * strides[1]
+        if wp.static(dim == 3):
+            n0 += b[2]
         for a in range(3):
             for c in range(3):
                 if wp.static(dim == 2):
                     w = W[a, 0] * W[c, 1]
-                    g = grid_v[b[0] + a, b[1] + c]
+                    g = grid_v[n0 + a * strides[0] + c]
                     dpos = (V(T(float(a)), T(float(c))) - fx) * dx
                     vn += w * g
                     B += wp.outer(w * g, dpos)
                 else:
                     for d in range(3):
                         w = W[a, 0] * W[c, 1] * W[d, 2]
-                        g = grid_v[b[0] + a, b[1] + c, b[2] + d]
+                        g = grid_v[n0 + a * strides[0] + c * strides[1] + d]
                         dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
                         vn += w * g
                         B += wp.outer(w * g, dpos)

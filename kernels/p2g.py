@@ -10,6 +10,12 @@ physical order:
    ``m v + (m C - dt V0 D^-1 tau) (x_i - x_p)``, ``D^-1 = 4 / dx^2``, to the
    ``3^dim`` nodes of the quadratic B-spline stencil.
 
+The grid is stored flat (one 1D array per grid copy, C order: node ``(i, j[, k])``
+at ``i s_0 + j s_1 [+ k]``, ``strides = (s_0, s_1[, 1])``): every array of the
+kernel is then one-dimensional and contiguous, which Warp's CPU code generator
+specialises (element strides known at compile time), and a stencil node is its
+base index plus a constant offset.
+
 In plane strain (``dim = 2``) positions are 2-vectors, the grid is 2D and the
 particle volume ``V0`` and mass are per unit depth (m^3/m, kg/m).
 
@@ -72,8 +78,9 @@ def p2g_kernel(dim, T, model, track_yield):
         inv_dx: T,
         dx: T,
         shape: Vi,
-        grid_m: wp.array(dtype=T, ndim=dim),
-        grid_p: wp.array(dtype=V, ndim=dim),
+        strides: Vi,
+        grid_m: wp.array(dtype=T),
+        grid_p: wp.array(dtype=V),
         counts: wp.array(dtype=wp.int32),
     ):
         i = wp.tid()
@@ -112,18 +119,23 @@ def p2g_kernel(dim, T, model, track_yield):
         if not in_grid(b, shape):
             wp.atomic_add(counts, 1, 1)
             return
+        n0 = b[0] * strides[0] + b[1] * strides[1]
+        if wp.static(dim == 3):
+            n0 += b[2]
         for a in range(3):
             for c in range(3):
                 if wp.static(dim == 2):
+                    n = n0 + a * strides[0] + c
                     w = W[a, 0] * W[c, 1]
                     dpos = (V(T(float(a)), T(float(c))) - fx) * dx
-                    wp.atomic_add(grid_m, b[0] + a, b[1] + c, w * mass)
-                    wp.atomic_add(grid_p, b[0] + a, b[1] + c, w * (mv + A * dpos))
+                    grid_m[n] += w * mass
+                    grid_p[n] += w * (mv + A * dpos)
                 else:
                     for d in range(3):
+                        n = n0 + a * strides[0] + c * strides[1] + d
                         w = W[a, 0] * W[c, 1] * W[d, 2]
                         dpos = (V(T(float(a)), T(float(c)), T(float(d))) - fx) * dx
-                        wp.atomic_add(grid_m, b[0] + a, b[1] + c, b[2] + d, w * mass)
-                        wp.atomic_add(grid_p, b[0] + a, b[1] + c, b[2] + d, w * (mv + A * dpos))
+                        grid_m[n] += w * mass
+                        grid_p[n] += w * (mv + A * dpos)
 
     return p2g

@@ -17,7 +17,7 @@ import warp as wp
 
 from .kernels.bonded_camclay import column_sums_zero_kernel, kappa_column_mean_kernel, kappa_column_sum_kernel
 from .kernels.g2p import g2p_kernel
-from .kernels.grid_update import grid_update_kernel
+from .kernels.grid_update import grid_update_kernel, wall_state_kernel
 from .kernels.p2g import p2g_kernel
 from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec
@@ -73,11 +73,19 @@ class Stepper:
         nt = max(1, min(nt, model.grid_shape[0] // 3, max(1, model.n_particles // 1000)))
         self.n_threads = nt
         gs = model.grid_shape
-        self.grid_m_all = wp.zeros((nt, *gs), dtype=T, device=dev)
-        self.grid_p_all = wp.zeros((nt, *gs), dtype=V, device=dev)
+        n_nodes = int(np.prod(gs))
+        # the kernels see the grid flat (node (i, j[, k]) at i s_0 + j s_1 [+ k]), copy k at k n_nodes
+        strides = Vi(*[int(np.prod(gs[a + 1:])) for a in range(dim)])
+        self._grid_m_flat = wp.zeros(nt * n_nodes, dtype=T, device=dev)
+        self._grid_p_flat = wp.zeros(nt * n_nodes, dtype=V, device=dev)
+        #: per-thread grid copies (views of the flat buffers): nodal masses (kg) and momenta (kg m/s)
+        self.grid_m_all = self._grid_m_flat.reshape((nt, *gs))
+        self.grid_p_all = self._grid_p_flat.reshape((nt, *gs))
         #: summed nodal mass (kg) and, after the grid update, nodal velocity (m/s)
         self.grid_m = self.grid_m_all[0]
         self.grid_p = self.grid_p_all[0]
+        self._grid_copies = [(self._grid_m_flat[k * n_nodes:(k + 1) * n_nodes],
+                              self._grid_p_flat[k * n_nodes:(k + 1) * n_nodes]) for k in range(nt)]
         self.dt = wp.zeros(1, dtype=T, device=dev)
         self.vmax = wp.zeros(nt, dtype=T, device=dev)
         self.seed_vmax()
@@ -101,6 +109,9 @@ class Stepper:
                                 device=dev, record_cmd=True)
         # per thread k: P2G launches, grid-update slab, G2P range
         self._p2g: list[list] = [[] for _ in range(nt)]
+        # fields a group does not have (never read: the kernel is built without them) are passed as one-element
+        # arrays, not None: Warp's CPU code takes its contiguous fast path only when every array is contiguous
+        unused = {t: wp.zeros(1, dtype=t, device=dev) for t in (T, wp.uint8)}
         for g in model.groups:
             mat = g.material
             plastic = mat.plastic
@@ -110,26 +121,39 @@ class Stepper:
                 if b <= a:
                     continue
                 sl = slice(a, b)
-                ljp, kap, yld = None, None, None
+                ljp, kap, yld = unused[T], unused[T], unused[wp.uint8]
                 if plastic:
                     psl = slice(g.plastic_start + a - g.start, g.plastic_start + b - g.start)
                     ljp = s.log_jp[psl]
-                    kap = s.kappa[psl] if g.columns is not None else None
-                    yld = s.yielded[psl] if s.yielded is not None else None
-                hz = s.hzz[sl] if s.hzz is not None else None
+                    kap = s.kappa[psl] if g.columns is not None else kap
+                    yld = s.yielded[psl] if s.yielded is not None else yld
+                hz = s.hzz[sl] if s.hzz is not None else unused[T]
                 self._p2g[k].append(wp.launch(
                     k_p2g, b - a,
                     inputs=[s.x[sl], s.v[sl], s.C[sl], s.H[sl], hz, ljp, kap, yld, T(g.mass), T(g.vol0), m_par,
-                            self.dt, origin, inv_dx, dx, shape, self.grid_m_all[k], self.grid_p_all[k],
-                            self.counts[k]],
+                            self.dt, origin, inv_dx, dx, shape, strides, *self._grid_copies[k], self.counts[k]],
                     device=dev, record_cmd=True))
+        # walls at the end of the step, evaluated once per step for every node of the grid update
+        self._wall_state = None
+        wall_point = wall_velocity = None
+        if has_walls:
+            wall_point = wp.zeros(nw, dtype=V, device=dev)
+            wall_velocity = wp.zeros(nw, dtype=V, device=dev)
+            self._wall_state = wp.launch(wall_state_kernel(T, dim), nw,
+                                         inputs=[model.walls_device, self.dt, s.clock, wall_point, wall_velocity],
+                                         device=dev, record_cmd=True)
+        # grid update by rows of nodes along the last axis: a whole row per thread on the CPU, a node on CUDA
+        rows = int(np.prod(gs[:-1]))
+        seg_len = 1 if wp.get_device(dev).is_cuda else gs[-1]
+        per_row = gs[-1] // seg_len
         self._grid = []
-        for k, (a, b) in enumerate(_chunks(0, gs[0], nt)):
+        for k, (a, b) in enumerate(_chunks(0, rows, nt)):
             self._grid.append(wp.launch(
-                grid_update_kernel(dim, T, has_walls), (b - a, *gs[1:]),
-                inputs=[self.grid_m_all, self.grid_p_all, a, self.dt, s.clock, V(*model.gravity),
-                        T(tc.gravity_ramp), T(tc.damping), T(tc.damping_until if tc.damping > 0 else 0.0),
-                        T(model.mass_threshold), origin, dx, model.walls_device,
+                grid_update_kernel(dim, T, has_walls), (b - a) * per_row,
+                inputs=[self._grid_m_flat, self._grid_p_flat, nt, a, seg_len, shape, strides, self.dt, s.clock,
+                        V(*model.gravity), T(tc.gravity_ramp), T(tc.damping),
+                        T(tc.damping_until if tc.damping > 0 else 0.0), T(model.mass_threshold), origin, dx,
+                        model.walls_device, wall_point, wall_velocity,
                         self.wall_impulses[k] if has_walls else None, self.vmax[k:k + 1]],
                 device=dev, record_cmd=True))
         self._g2p = []
@@ -137,8 +161,8 @@ class Stepper:
             sl = slice(a, b)
             self._g2p.append(wp.launch(
                 g2p_kernel(dim, T), b - a,
-                inputs=[s.x[sl], s.v[sl], s.C[sl], self.grid_p, self.dt, origin, inv_dx, dx, shape, V(*model.x_lo),
-                        V(*model.x_hi), self.counts[k]],
+                inputs=[s.x[sl], s.v[sl], s.C[sl], self._grid_copies[0][1], self.dt, origin, inv_dx, dx, shape,
+                        strides, V(*model.x_lo), V(*model.x_hi), self.counts[k]],
                 device=dev, record_cmd=True))
         # bonded weak layers: kappa replaced by its lattice-column mean after every step (kernels/bonded_camclay.py)
         self._columns = []
@@ -167,18 +191,22 @@ class Stepper:
     @property
     def launches(self) -> list:
         """Every recorded launch of the plan (for compiling ahead of timing)."""
-        return [self._begin, *[k for ks in self._p2g for k in ks], *self._grid, *self._g2p, *self._columns,
-                self._end, *self.actions]
+        walls = [self._wall_state] if self._wall_state is not None else []
+        return [self._begin, *walls, *[k for ks in self._p2g for k in ks], *self._grid, *self._g2p,
+                *self._columns, self._end, *self.actions]
 
     # ------------------------------------------------------------------ steps
     def _scatter(self, k: int) -> None:
-        self.grid_m_all[k].zero_()
-        self.grid_p_all[k].zero_()
+        gm, gp = self._grid_copies[k]
+        gm.zero_()
+        gp.zero_()
         for launch in self._p2g[k]:
             launch.launch()
 
     def _launch_step(self) -> None:
         self._begin.launch()
+        if self._wall_state is not None:
+            self._wall_state.launch()
         for a in self.actions:
             a.launch()
         if self._pool is None:
