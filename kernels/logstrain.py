@@ -16,7 +16,10 @@ summed by scalar recurrences (Cayley-Hamilton; see :func:`log_strain_func`),
 far cheaper than an SVD or an eigen-decomposition. With ``|X|_F <= 0.1`` and
 ``n = 6`` (float32) the truncation error is below ``0.1^7 / 7 = 1.4e-8``, under
 float32 round-off; float64 sums 15 terms (``0.1^16 / 16 = 6e-18``), so its
-verification runs are not limited by the series. Larger strains, and any
+verification runs are not limited by the series. Tiny strains (below 2e-4 in
+float32, 1e-8 in float64) take one or two terms: the rest lies below the
+rounding of the result and would otherwise underflow into subnormal numbers,
+which a CPU computes a hundred times slower. Larger strains, and any
 ``det F <= 0`` (a reflection has ``b = I`` too), fall back to the SVD path,
 which the caller runs when ``ok == 0``.
 
@@ -45,61 +48,88 @@ def log_strain_func(T, dim=3):
     (``X^2 = t X - d I``, ``t = tr X``, ``d = det X``) and ``a I + b X + c X^2`` in
     3D (``X^3 = I1 X^2 - I2 X + I3 I``), so ``log(I + X) = alpha I + beta X
     [+ gamma X^2]`` costs one matrix product in 3D and none in 2D.
+
+    Tiny strains take the first terms only, where the rest lies below a quarter
+    rounding unit ``u/4`` of the result (``u = 2^-24`` float32, ``2^-53`` float64)
+    and would otherwise be computed in subnormal numbers (a hundred times slower
+    on a CPU): ``eps = (H + H^T)/2`` when ``max |H_ij| <= u/16`` (then ``|H H^T|
+    <= dim u/16 |H|``), ``eps = (X - X^2/2)/2`` when ``|X|^2/3 <= u/4``.
     """
     M = mat(dim, T)
     order = 6 if T == wp.float32 else 15  # truncation |X|^(n+1)/(n+1) < 1.4e-8 (float32) / 6e-18 (float64) of |X|
+    u = 2.0**-24 if T == wp.float32 else 2.0**-53
+    h_first = u / 16.0  # max |H_ij| up to which eps = (H + H^T) / 2
+    x2_second = 3.0 * u / 4.0  # |X|_F^2 up to which two terms suffice: |X|^2 / 3 <= u / 4
 
     @wp.func
     def log_strain(H: M):
         I = wp.identity(dim, dtype=T)
+        h_max = T(0.0)  # a balanced max tree: short dependency chains
+        if wp.static(dim == 2):
+            h_max = wp.max(wp.max(wp.abs(H[0, 0]), wp.abs(H[0, 1])), wp.max(wp.abs(H[1, 0]), wp.abs(H[1, 1])))
+        else:
+            r0 = wp.max(wp.max(wp.abs(H[0, 0]), wp.abs(H[0, 1])), wp.abs(H[0, 2]))
+            r1 = wp.max(wp.max(wp.abs(H[1, 0]), wp.abs(H[1, 1])), wp.abs(H[1, 2]))
+            r2 = wp.max(wp.max(wp.abs(H[2, 0]), wp.abs(H[2, 1])), wp.abs(H[2, 2]))
+            h_max = wp.max(wp.max(r0, r1), r2)
+        if h_max <= T(h_first):
+            return T(0.5) * (H + wp.transpose(H)), 1  # det F > 0: |H| < 1/dim
         X = H + wp.transpose(H) + H * wp.transpose(H)
         ok = 0
         eps = M()
-        if wp.ddot(X, X) <= T(0.01) and wp.determinant(I + H) > T(0.0):
+        s2 = wp.ddot(X, X)
+        if s2 <= T(0.01) and wp.determinant(I + H) > T(0.0):
             ok = 1
             if wp.static(dim == 2):
                 t = X[0, 0] + X[1, 1]
                 d = X[0, 0] * X[1, 1] - X[0, 1] * X[1, 0]
-                # X^k = p I + q X; X^(k+1) = -d q I + (p + t q) X
-                p = T(0.0)
-                q = T(1.0)
-                alpha = T(0.0)
-                beta = T(1.0)
-                sign = T(1.0)
-                for k in range(2, order + 1):
-                    p_next = -d * q
-                    q = p + t * q
-                    p = p_next
-                    sign = -sign
-                    ck = sign / T(float(k))
-                    alpha += ck * p
-                    beta += ck * q
-                eps = T(0.5) * (alpha * I + beta * X)
+                if s2 <= T(x2_second):
+                    # X - X^2/2 = d/2 I + (1 - t/2) X
+                    eps = T(0.5) * ((T(0.5) * d) * I + (T(1.0) - T(0.5) * t) * X)
+                else:
+                    # X^k = p I + q X; X^(k+1) = -d q I + (p + t q) X
+                    p = T(0.0)
+                    q = T(1.0)
+                    alpha = T(0.0)
+                    beta = T(1.0)
+                    sign = T(1.0)
+                    for k in range(2, wp.static(order + 1)):  # unrolled: constant bounds
+                        p_next = -d * q
+                        q = p + t * q
+                        p = p_next
+                        sign = -sign
+                        ck = sign / T(float(k))
+                        alpha += ck * p
+                        beta += ck * q
+                    eps = T(0.5) * (alpha * I + beta * X)
             else:
                 X2 = X * X
-                i1 = wp.trace(X)
-                i2 = T(0.5) * (i1 * i1 - wp.trace(X2))
-                i3 = wp.determinant(X)
-                # X^k = a I + b X + c X^2; X^(k+1) = c i3 I + (a - c i2) X + (b + c i1) X^2
-                a = T(0.0)
-                b = T(0.0)
-                c = T(1.0)
-                alpha = T(0.0)
-                beta = T(1.0)
-                gamma = T(-0.5)
-                sign = T(-1.0)
-                for k in range(3, order + 1):
-                    a_next = c * i3
-                    b_next = a - c * i2
-                    c = b + c * i1
-                    a = a_next
-                    b = b_next
-                    sign = -sign
-                    ck = sign / T(float(k))
-                    alpha += ck * a
-                    beta += ck * b
-                    gamma += ck * c
-                eps = T(0.5) * (alpha * I + beta * X + gamma * X2)
+                if s2 <= T(x2_second):
+                    eps = T(0.5) * (X - T(0.5) * X2)
+                else:
+                    i1 = wp.trace(X)
+                    i2 = T(0.5) * (i1 * i1 - wp.trace(X2))
+                    i3 = wp.determinant(X)
+                    # X^k = a I + b X + c X^2; X^(k+1) = c i3 I + (a - c i2) X + (b + c i1) X^2
+                    a = T(0.0)
+                    b = T(0.0)
+                    c = T(1.0)
+                    alpha = T(0.0)
+                    beta = T(1.0)
+                    gamma = T(-0.5)
+                    sign = T(-1.0)
+                    for k in range(3, wp.static(order + 1)):  # unrolled: constant bounds
+                        a_next = c * i3
+                        b_next = a - c * i2
+                        c = b + c * i1
+                        a = a_next
+                        b = b_next
+                        sign = -sign
+                        ck = sign / T(float(k))
+                        alpha += ck * a
+                        beta += ck * b
+                        gamma += ck * c
+                    eps = T(0.5) * (alpha * I + beta * X + gamma * X2)
         return eps, ok
 
     return log_strain
@@ -137,3 +167,65 @@ def expm1_func(T):
         return r
 
     return expm1
+
+
+@functools.cache
+def expm1_sym_func(T, dim=3):
+    """Return ``expm1_sym(D) -> exp(D) - I`` for a small symmetric ``dim x dim`` matrix ``D`` (``|D|_F <= 1/4``).
+
+    The series ``sum_k D^k / k!`` from ``k = 1`` (no cancellation against ``I``, so a
+    strain increment of 1e-9 keeps its digits), summed with the scalar recurrences of
+    :func:`log_strain_func` (Cayley-Hamilton). With ``|D|_F <= 1/4`` the first omitted term is
+    below ``|D| 4^-n / (n + 1)!``: ``n = 8`` (float32, 4e-11 of ``|D|``) and ``n = 13``
+    (float64, 2e-19). The constitutive update applies it to the plastic correction
+    ``D = eps_new - eps`` of a return that kept the eigenvectors of the trial.
+    """
+    M = mat(dim, T)
+    order = 8 if T == wp.float32 else 13
+
+    @wp.func
+    def expm1_sym(D: M):
+        I = wp.identity(dim, dtype=T)
+        if wp.static(dim == 2):
+            t = D[0, 0] + D[1, 1]
+            d = D[0, 0] * D[1, 1] - D[0, 1] * D[1, 0]
+            # D^k = p I + q D; D^(k+1) = -d q I + (p + t q) D
+            p = T(0.0)
+            q = T(1.0)
+            alpha = T(0.0)
+            beta = T(1.0)
+            ck = T(1.0)
+            for k in range(2, wp.static(order + 1)):  # unrolled: constant bounds
+                p_next = -d * q
+                q = p + t * q
+                p = p_next
+                ck = ck / T(float(k))
+                alpha += ck * p
+                beta += ck * q
+            return alpha * I + beta * D
+        else:
+            D2 = D * D
+            i1 = wp.trace(D)
+            i2 = T(0.5) * (i1 * i1 - wp.trace(D2))
+            i3 = wp.determinant(D)
+            # D^k = a I + b D + c D^2; D^(k+1) = c i3 I + (a - c i2) D + (b + c i1) D^2
+            a = T(0.0)
+            b = T(0.0)
+            c = T(1.0)
+            alpha = T(0.0)
+            beta = T(1.0)
+            gamma = T(0.5)
+            ck = T(0.5)
+            for k in range(3, wp.static(order + 1)):  # unrolled: constant bounds
+                a_next = c * i3
+                b_next = a - c * i2
+                c = b + c * i1
+                a = a_next
+                b = b_next
+                ck = ck / T(float(k))
+                alpha += ck * a
+                beta += ck * b
+                gamma += ck * c
+            return alpha * I + beta * D + gamma * D2
+
+    return expm1_sym
