@@ -9,8 +9,16 @@ for bit. Per particle and step (MODEL.md 1 and 4, SI Note 1):
    ``H_tr = H + L + L H`` with ``L = dt C`` (:func:`trial_func`): an increment far
    below float32's resolution of 1 (1e-9 in a settling layer) is kept, where
    ``(I + L) F`` would round it away and a settled column would creep forever;
-2. small elastic strain (and, for plastic models, a state inside the yield
-   surface): Hencky strain by its series, no SVD (``kernels/logstrain.py``);
+2. small strain (``|F F^T - I|_F <= 0.1``, ``det F > 0``): Hencky strain ``eps`` by its
+   series, no decomposition (``kernels/logstrain.py``). Inside the yield surface (or
+   elastic) that is the answer. A yielding trial takes the return without a
+   decomposition too: the return is isotropic and keeps the direction of
+   ``dev eps``, so it runs on the invariants ``(tr eps, |dev eps|)`` and gives
+   ``eps_new = s dev(eps) + tr(eps_new)/3 I``, coaxial with ``eps``; then
+   ``F_new = exp(eps_new - eps) F_tr``, i.e. ``H_new = H_tr + expm1(D) (I + H_tr)``,
+   ``D = eps_new - eps``, with ``expm1`` of the symmetric ``D`` by its series. This is
+   step 3's update written without ``U`` (``U diag(f(eps_i)) U^T = f(eps)``): the two
+   agree to rounding (``tests/test_coaxial_return.py``) without the decomposition;
 3. otherwise the principal stretches: the eigen-decomposition ``X = U diag(lambda) U^T``
    of ``X = F F^T - I = H + H^T + H H^T`` (formed from ``H``, so a strain of 1e-6 keeps
    its relative precision; ``U`` are the left singular vectors of ``F``) gives the
@@ -43,7 +51,7 @@ import warp as wp
 from .bonded_camclay import bonded_camclay_return_strain_func, bonded_p0_func
 from .camclay import camclay_p0_func, camclay_return_strain_func, camclay_yield_func
 from .elasticity import hencky_strain_func
-from .logstrain import expm1_func, log1p_func, log_strain_func
+from .logstrain import expm1_func, expm1_sym_func, log1p_func, log_strain_func
 from .principal import principal_strain_func
 from .types import mat, vec
 
@@ -146,8 +154,12 @@ def _model_funcs(T, model):
 
 
 @functools.cache
-def constitutive_update_func(dim, T, model):
+def constitutive_update_func(dim, T, model, decomposition_free=True):
     """Build the constitutive update of ``model`` for dimension ``dim`` and scalar type ``T``.
+
+    ``decomposition_free``: a yielding trial whose series strain is known takes the
+    return without a decomposition (``coaxial`` below); False builds the update that
+    takes the principal-strain path for every yielding trial (the reference of the tests).
 
     Signatures of the returned ``wp.func`` (``mat``/``vec`` of size ``dim``)::
 
@@ -183,11 +195,15 @@ def constitutive_update_func(dim, T, model):
     principal_strain = principal_strain_func(T, dim)
     hencky_strain = hencky_strain_func(T)
     expm1 = expm1_func(T)
+    expm1_sym = expm1_sym_func(T, dim)
     sqrt6 = _SQRT6
+    sqrt2_3 = math.sqrt(2.0 / 3.0)  # Python floats: a math call inside a kernel would round through float32
+    inv_sqrt6 = 1.0 / _SQRT6
 
     @wp.func
     def small_strain(H_tr: M, hzz: T, lj: T, kap: T, m: P):
-        """Hencky strain by the series, and whether it applies (small, elastic, not inverted)."""
+        """Hencky strain by the series; ``ok``: the series applies (small, not inverted); ``yld``: the trial lies
+        outside the yield surface (plastic models). Also ``eps_zz`` (2D), the trace and ``|dev eps|^2``."""
         eps, ok = log_strain(H_tr)
         ezz = T(0.0)
         tr = wp.trace(eps)
@@ -197,6 +213,8 @@ def constitutive_update_func(dim, T, model):
             else:
                 ezz = log1p(hzz)
                 tr = tr + ezz
+        dev2 = T(0.0)
+        yld = int(0)
         if wp.static(plastic):
             if ok != 0:
                 mean = tr / T(3.0)
@@ -206,8 +224,47 @@ def constitutive_update_func(dim, T, model):
                     dev2 = dev2 + (ezz - mean) * (ezz - mean)
                 K = m.lam + (T(2.0) / T(3.0)) * m.mu
                 if yield_check(-K * tr, T(sqrt6) * m.mu * wp.sqrt(dev2), lj, kap, m) > T(0.0):
-                    ok = 0
-        return eps, tr, ok
+                    yld = 1
+        return eps, ezz, tr, dev2, ok, yld
+
+    @wp.func
+    def coaxial(H_tr: M, hzz: T, eps: M, ezz: T, tr: T, dev2: T, lj: T, kap: T, m: P):
+        """Return mapping without a decomposition, for a trial whose series strain ``eps`` is known.
+
+        The return is isotropic and radial in the deviatoric plane, so it needs only ``tr eps`` and
+        ``|dev eps|`` and keeps the eigenvectors: it runs on principal strains with those invariants,
+        ``(m + r sqrt(2/3), m - r/sqrt(6), m - r/sqrt(6))``, and gives ``eps_new = s dev(eps) + tr(eps_new)/3 I``.
+        ``eps_new`` is coaxial with ``eps``, hence ``F_new = exp(eps_new - eps) F_tr`` (the general path's
+        ``U diag(exp(eps_new - eps)) U^T F_tr`` without ``U``), with ``exp - I`` by its series. ``done = 0``
+        when the correction is too large for that series (``|eps_new - eps|_F > 1/4``): the caller then
+        takes the general path.
+        """
+        I = wp.identity(dim, dtype=T)
+        mean = tr / T(3.0)
+        r = wp.sqrt(dev2)
+        e_hi = mean + r * T(sqrt2_3)
+        e_lo = mean - r * T(inv_sqrt6)
+        e_tr = V3(e_hi, e_lo, e_lo)
+        e_new, lj_new, kap_new, y = principal_return(e_tr, lj, kap, m)
+        tr_new = e_new[0] + e_new[1] + e_new[2]
+        if int(y) == 0:  # inside the surface after all (rounding of the invariants): elastic
+            return H_tr, hzz, T(2.0) * m.mu * eps + (m.lam * tr) * I, lj, kap, int(0), int(1)
+        scale = T(0.0)  # s = |dev eps_new| / |dev eps|, from the principal values (0 for a pure volumetric trial)
+        if e_hi > e_lo:
+            scale = (e_new[0] - e_new[1]) / (e_hi - e_lo)
+        mean_new = tr_new / T(3.0)
+        eps_new = scale * (eps - mean * I) + mean_new * I
+        D = eps_new - eps
+        Dzz = T(0.0)
+        if wp.static(dim == 2):
+            Dzz = (scale * (ezz - mean) + mean_new) - ezz
+        if wp.ddot(D, D) + Dzz * Dzz > T(0.0625):
+            return H_tr, hzz, M(), lj, kap, int(0), int(0)
+        H_new = H_tr + expm1_sym(D) * (I + H_tr)
+        hzz_new = hzz
+        if wp.static(dim == 2):
+            hzz_new = hzz + (T(1.0) + hzz) * expm1(Dzz)
+        return H_new, hzz_new, T(2.0) * m.mu * eps_new + (m.lam * tr_new) * I, lj_new, kap_new, YIELDED, int(1)
 
     @wp.func
     def strain_update(eps: V3, lj: T, kap: T, m: P):
@@ -263,23 +320,29 @@ def constitutive_update_func(dim, T, model):
             Dt[a, a] = tau_p[a]
         return H_new, hzz_new, U * Dt * wp.transpose(U), lj_new, kap_new, flags
 
+    @wp.func
+    def update_any(H_tr: M, hzz: T, lj: T, kap: T, m: P):
+        eps, ezz, tr, dev2, ok, yld = small_strain(H_tr, hzz, lj, kap, m)
+        if ok != 0:
+            if yld == 0:
+                return H_tr, hzz, T(2.0) * m.mu * eps + (m.lam * tr) * wp.identity(dim, dtype=T), lj, kap, int(0)
+            if wp.static(plastic and decomposition_free):
+                H_new, hzz_new, tau, lj_new, kap_new, flags, done = coaxial(H_tr, hzz, eps, ezz, tr, dev2, lj, kap, m)
+                if done != 0:
+                    return H_new, hzz_new, tau, lj_new, kap_new, flags
+        return general(H_tr, hzz, lj, kap, m)
+
     if dim == 2:
 
         @wp.func
         def update(H_tr: M, hzz: T, lj: T, kap: T, m: P):
-            eps, tr, ok = small_strain(H_tr, hzz, lj, kap, m)
-            if ok != 0:
-                return H_tr, hzz, T(2.0) * m.mu * eps + (m.lam * tr) * wp.identity(dim, dtype=T), lj, kap, int(0)
-            return general(H_tr, hzz, lj, kap, m)
+            return update_any(H_tr, hzz, lj, kap, m)
 
     else:
 
         @wp.func
         def update(H_tr: M, lj: T, kap: T, m: P):
-            eps, tr, ok = small_strain(H_tr, T(0.0), lj, kap, m)
-            if ok != 0:
-                return H_tr, T(2.0) * m.mu * eps + (m.lam * tr) * wp.identity(dim, dtype=T), lj, kap, int(0)
-            H_new, hzz_new, tau, lj_new, kap_new, flags = general(H_tr, T(0.0), lj, kap, m)
+            H_new, hzz_new, tau, lj_new, kap_new, flags = update_any(H_tr, T(0.0), lj, kap, m)
             return H_new, tau, lj_new, kap_new, flags
 
     return update
