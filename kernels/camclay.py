@@ -33,6 +33,7 @@ __all__ = [
     "SINGULAR_VALUE_FLOOR",
     "camclay_p0_func",
     "camclay_pq_func",
+    "camclay_project_func",
     "camclay_return_func",
     "camclay_return_strain_func",
     "camclay_yield_func",
@@ -272,39 +273,17 @@ def camclay_return_func(T):
 
 
 @functools.cache
-def camclay_return_strain_func(T):
-    """Build the return mapping in principal Hencky strains, the core of :func:`camclay_return_func`.
+def camclay_project_func(T):
+    """Build ``camclay_project(p_tr, q_tr, p0, K, mu, M, beta) -> (p_new, q_new)`` (Pa).
 
-    Signature of the returned ``wp.func``::
-
-        camclay_return_strain(eps: vec3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T,
-                              p0_floor: T) -> (eps_new: vec3, log_jp_new: T, yielded: int32)
-
-    ``eps`` are the principal Hencky strains of the trial (-), e.g. ``ln s`` or, with
-    full relative precision for small strains, ``1/2 log1p(lambda)`` of the
-    eigenvalues ``lambda`` of ``F F^T - I`` (``kernels/constitutive.py``). Everything
-    else as :func:`camclay_return_func`; an elastic trial returns ``eps`` itself.
+    The point of the yield ellipse of ``p0`` closest to a trial ``(p_tr, q_tr)``
+    outside it, in the energy metric ``dp^2/K + dq^2/(3 mu)`` (the projection of
+    :func:`camclay_return_func`, which see): stress-free for ``p0 <= 0``.
     """
-    v3 = vec3(T)
-    sqrt6 = _SQRT6
-    yield_fn = camclay_yield_func(T)
-    p0_fn = camclay_p0_func(T)
     closest = _ellipse_closest_func(T)
 
     @wp.func
-    def camclay_return_strain(eps: v3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T):
-        tr = eps[0] + eps[1] + eps[2]
-        m = tr / T(3.0)
-        dev = v3(eps[0] - m, eps[1] - m, eps[2] - m)
-        if eps[0] == eps[1] and eps[1] == eps[2]:
-            dev = v3(T(0.0), T(0.0), T(0.0))  # repeated singular values: tr/3 may round off eps
-        K = lam + T(2.0) / T(3.0) * mu
-        p_tr = -K * tr
-        q_tr = T(sqrt6) * mu * wp.length(dev)
-        p0 = p0_fn(log_jp, K, xi, p0_floor)
-        if yield_fn(p_tr, q_tr, p0, M, beta) <= T(0.0):
-            return eps, log_jp, wp.int32(0)
-
+    def camclay_project(p_tr: T, q_tr: T, p0: T, K: T, mu: T, M: T, beta: T):
         p_new = T(0.0)
         q_new = T(0.0)
         a = T(0.5) * p0 * (T(1.0) + beta)
@@ -326,7 +305,46 @@ def camclay_return_strain_func(T):
             else:
                 p_new = p0 - a * (T(1.0) - xu)
             q_new = a * rho * xv
+        return p_new, q_new
 
+    return camclay_project
+
+
+@functools.cache
+def camclay_return_strain_func(T):
+    """Build the return mapping in principal Hencky strains, the core of :func:`camclay_return_func`.
+
+    Signature of the returned ``wp.func``::
+
+        camclay_return_strain(eps: vec3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T,
+                              p0_floor: T) -> (eps_new: vec3, log_jp_new: T, yielded: int32)
+
+    ``eps`` are the principal Hencky strains of the trial (-), e.g. ``ln s`` or, with
+    full relative precision for small strains, ``1/2 log1p(lambda)`` of the
+    eigenvalues ``lambda`` of ``F F^T - I`` (``kernels/constitutive.py``). Everything
+    else as :func:`camclay_return_func`; an elastic trial returns ``eps`` itself.
+    """
+    v3 = vec3(T)
+    sqrt6 = _SQRT6
+    yield_fn = camclay_yield_func(T)
+    p0_fn = camclay_p0_func(T)
+    project = camclay_project_func(T)
+
+    @wp.func
+    def camclay_return_strain(eps: v3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T):
+        tr = eps[0] + eps[1] + eps[2]
+        m = tr / T(3.0)
+        dev = v3(eps[0] - m, eps[1] - m, eps[2] - m)
+        if eps[0] == eps[1] and eps[1] == eps[2]:
+            dev = v3(T(0.0), T(0.0), T(0.0))  # repeated singular values: tr/3 may round off eps
+        K = lam + T(2.0) / T(3.0) * mu
+        p_tr = -K * tr
+        q_tr = T(sqrt6) * mu * wp.length(dev)
+        p0 = p0_fn(log_jp, K, xi, p0_floor)
+        if yield_fn(p_tr, q_tr, p0, M, beta) <= T(0.0):
+            return eps, log_jp, wp.int32(0)
+
+        p_new, q_new = project(p_tr, q_tr, p0, K, mu, M, beta)
         scale = T(0.0)
         if q_tr > T(0.0):
             scale = wp.min(q_new / q_tr, T(1.0))

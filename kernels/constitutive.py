@@ -49,7 +49,7 @@ import math
 import warp as wp
 
 from .bonded_camclay import bonded_camclay_return_strain_func, bonded_p0_func
-from .camclay import camclay_p0_func, camclay_return_strain_func, camclay_yield_func
+from .camclay import camclay_p0_func, camclay_project_func, camclay_return_strain_func, camclay_yield_func
 from .elasticity import hencky_strain_func
 from .logstrain import expm1_func, expm1_sym_func, log1p_func, log_strain_func
 from .principal import principal_strain_func
@@ -109,32 +109,57 @@ def trial_func(T, dim=3):
 
 @functools.cache
 def _model_funcs(T, model):
-    """``(yield_check, principal_return)`` of a plastic model (None, None for elastic).
+    """``(yield_check, principal_return, invariant_return)`` of a plastic model (None each for elastic).
 
-    ``yield_check(p, q, lj, kappa, mat) -> y`` (> 0 outside the surface);
+    ``yield_check(p, q, lj, kappa, mat) -> (y, p0)``: ``y > 0`` outside the surface, and the
+    consolidation pressure it used (Pa; Cam-Clay: passed on to ``invariant_return``, which
+    then need not compute it again);
     ``principal_return(eps, lj, kappa, mat) -> (eps_new, lj_new, kappa_new, yielded)`` in principal
-    Hencky strains. Cam-Clay carries ``kappa`` through unchanged.
+    Hencky strains;
+    ``invariant_return(tr, r, p0, lj, kappa, mat) -> (s, tr_new, lj_new, kappa_new, yielded)``: the
+    same return for a trial given by its invariants ``tr = tr(eps)``, ``r = |dev eps|`` (the return
+    is isotropic and keeps the direction of ``dev eps``), as ``dev eps_new = s dev eps`` and
+    ``tr(eps_new)``. Cam-Clay runs its projection on ``(p, q)`` directly and carries ``kappa``
+    through unchanged; the bonded layer runs its principal-strain return on the principal strains
+    ``(m + r sqrt(2/3), m - r/sqrt(6), m - r/sqrt(6))``, ``m = tr/3``, which have those invariants.
     """
     if model == "elastic":
-        return None, None
+        return None, None, None
     if model not in MODELS:
         raise ValueError(f"unknown material model {model!r}; expected one of {MODELS}")
     P = material_struct(T)
     V3 = vec(3, T)
     yf = camclay_yield_func(T)
+    sqrt6 = _SQRT6
+    sqrt2_3 = math.sqrt(2.0 / 3.0)  # Python floats: a math call inside a kernel would round through float32
+    inv_sqrt6 = 1.0 / _SQRT6
     if model == "camclay":
         p0f = camclay_p0_func(T)
         ret = camclay_return_strain_func(T)
+        project = camclay_project_func(T)
 
         @wp.func
         def yield_check(p: T, q: T, lj: T, kappa: T, m: P):
             K = m.lam + (T(2.0) / T(3.0)) * m.mu
-            return yf(p, q, p0f(lj, K, m.xi, m.p0_floor), m.M, m.beta)
+            p0 = p0f(lj, K, m.xi, m.p0_floor)
+            return yf(p, q, p0, m.M, m.beta), p0
 
         @wp.func
         def principal_return(eps: V3, lj: T, kappa: T, m: P):
             e, l2, y = ret(eps, lj, m.mu, m.lam, m.M, m.beta, m.xi, m.p0_floor)
             return e, l2, kappa, y
+
+        @wp.func
+        def invariant_return(tr: T, r: T, p0: T, lj: T, kappa: T, m: P):
+            # camclay_return_strain's projection and bookkeeping, on the invariants
+            K = m.lam + T(2.0) / T(3.0) * m.mu
+            q_tr = T(sqrt6) * m.mu * r
+            p_new, q_new = project(-K * tr, q_tr, p0, K, m.mu, m.M, m.beta)
+            scale = T(0.0)
+            if q_tr > T(0.0):
+                scale = wp.min(q_new / q_tr, T(1.0))
+            m_new = -p_new / (T(3.0) * K)
+            return scale, T(3.0) * m_new, lj + tr - T(3.0) * m_new, kappa, int(1)
 
     else:
         bp0 = bonded_p0_func(T)
@@ -144,13 +169,25 @@ def _model_funcs(T, model):
         def yield_check(p: T, q: T, lj: T, kappa: T, m: P):
             K = m.lam + (T(2.0) / T(3.0)) * m.mu
             p0, b = bp0(lj, kappa, K, m.xi, m.p0_floor, m.p_bond, m.kappa_s)
-            return yf(p, q, p0, m.M, m.beta * b)
+            return yf(p, q, p0, m.M, m.beta * b), p0
 
         @wp.func
         def principal_return(eps: V3, lj: T, kappa: T, m: P):
             return bret(eps, lj, kappa, m.mu, m.lam, m.M, m.beta, m.xi, m.p0_floor, m.p_bond, m.kappa_s)
 
-    return yield_check, principal_return
+        @wp.func
+        def invariant_return(tr: T, r: T, p0: T, lj: T, kappa: T, m: P):
+            mean = tr / T(3.0)
+            e_hi = mean + r * T(sqrt2_3)
+            e_lo = mean - r * T(inv_sqrt6)
+            e_new, lj_new, kap_new, y = bret(V3(e_hi, e_lo, e_lo), lj, kappa, m.mu, m.lam, m.M, m.beta, m.xi,
+                                             m.p0_floor, m.p_bond, m.kappa_s)
+            scale = T(0.0)  # from the principal values (0 for a pure volumetric trial)
+            if e_hi > e_lo:
+                scale = (e_new[0] - e_new[1]) / (e_hi - e_lo)
+            return scale, e_new[0] + e_new[1] + e_new[2], lj_new, kap_new, int(y)
+
+    return yield_check, principal_return, invariant_return
 
 
 @functools.cache
@@ -189,7 +226,7 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
     V3 = vec(3, T)
     P = material_struct(T)
     plastic = model != "elastic"
-    yield_check, principal_return = _model_funcs(T, model)
+    yield_check, principal_return, invariant_return = _model_funcs(T, model)
     log_strain = log_strain_func(T, dim)
     log1p = log1p_func(T)
     principal_strain = principal_strain_func(T, dim)
@@ -197,13 +234,12 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
     expm1 = expm1_func(T)
     expm1_sym = expm1_sym_func(T, dim)
     sqrt6 = _SQRT6
-    sqrt2_3 = math.sqrt(2.0 / 3.0)  # Python floats: a math call inside a kernel would round through float32
-    inv_sqrt6 = 1.0 / _SQRT6
 
     @wp.func
     def small_strain(H_tr: M, hzz: T, lj: T, kap: T, m: P):
         """Hencky strain by the series; ``ok``: the series applies (small, not inverted); ``yld``: the trial lies
-        outside the yield surface (plastic models). Also ``eps_zz`` (2D), the trace and ``|dev eps|^2``."""
+        outside the yield surface (plastic models). Also ``eps_zz`` (2D), the trace, ``|dev eps|`` and the
+        consolidation pressure of the yield check."""
         eps, ok = log_strain(H_tr)
         ezz = T(0.0)
         tr = wp.trace(eps)
@@ -213,7 +249,8 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
             else:
                 ezz = log1p(hzz)
                 tr = tr + ezz
-        dev2 = T(0.0)
+        r = T(0.0)
+        p0 = T(0.0)
         yld = int(0)
         if wp.static(plastic):
             if ok != 0:
@@ -222,36 +259,29 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
                 dev2 = wp.ddot(dev, dev)
                 if wp.static(dim == 2):
                     dev2 = dev2 + (ezz - mean) * (ezz - mean)
+                r = wp.sqrt(dev2)
                 K = m.lam + (T(2.0) / T(3.0)) * m.mu
-                if yield_check(-K * tr, T(sqrt6) * m.mu * wp.sqrt(dev2), lj, kap, m) > T(0.0):
+                y, p0 = yield_check(-K * tr, T(sqrt6) * m.mu * r, lj, kap, m)
+                if y > T(0.0):
                     yld = 1
-        return eps, ezz, tr, dev2, ok, yld
+        return eps, ezz, tr, r, p0, ok, yld
 
     @wp.func
-    def coaxial(H_tr: M, hzz: T, eps: M, ezz: T, tr: T, dev2: T, lj: T, kap: T, m: P):
-        """Return mapping without a decomposition, for a trial whose series strain ``eps`` is known.
+    def coaxial(H_tr: M, hzz: T, eps: M, ezz: T, tr: T, r: T, p0: T, lj: T, kap: T, m: P):
+        """Return mapping without a decomposition, for a yielding trial whose series strain ``eps`` is known.
 
         The return is isotropic and radial in the deviatoric plane, so it needs only ``tr eps`` and
-        ``|dev eps|`` and keeps the eigenvectors: it runs on principal strains with those invariants,
-        ``(m + r sqrt(2/3), m - r/sqrt(6), m - r/sqrt(6))``, and gives ``eps_new = s dev(eps) + tr(eps_new)/3 I``.
-        ``eps_new`` is coaxial with ``eps``, hence ``F_new = exp(eps_new - eps) F_tr`` (the general path's
-        ``U diag(exp(eps_new - eps)) U^T F_tr`` without ``U``), with ``exp - I`` by its series. ``done = 0``
-        when the correction is too large for that series (``|eps_new - eps|_F > 1/4``): the caller then
-        takes the general path.
+        ``r = |dev eps|`` and keeps the eigenvectors (``invariant_return``): ``eps_new = s dev(eps) +
+        tr(eps_new)/3 I``. ``eps_new`` is coaxial with ``eps``, hence ``F_new = exp(eps_new - eps) F_tr``
+        (the general path's ``U diag(exp(eps_new - eps)) U^T F_tr`` without ``U``), with ``exp - I`` by
+        its series. ``done = 0`` when the correction is too large for that series
+        (``|eps_new - eps|_F > 1/4``): the caller then takes the general path.
         """
         I = wp.identity(dim, dtype=T)
-        mean = tr / T(3.0)
-        r = wp.sqrt(dev2)
-        e_hi = mean + r * T(sqrt2_3)
-        e_lo = mean - r * T(inv_sqrt6)
-        e_tr = V3(e_hi, e_lo, e_lo)
-        e_new, lj_new, kap_new, y = principal_return(e_tr, lj, kap, m)
-        tr_new = e_new[0] + e_new[1] + e_new[2]
-        if int(y) == 0:  # inside the surface after all (rounding of the invariants): elastic
+        scale, tr_new, lj_new, kap_new, y = invariant_return(tr, r, p0, lj, kap, m)
+        if y == 0:  # inside the surface after all (rounding of the invariants): elastic
             return H_tr, hzz, T(2.0) * m.mu * eps + (m.lam * tr) * I, lj, kap, int(0), int(1)
-        scale = T(0.0)  # s = |dev eps_new| / |dev eps|, from the principal values (0 for a pure volumetric trial)
-        if e_hi > e_lo:
-            scale = (e_new[0] - e_new[1]) / (e_hi - e_lo)
+        mean = tr / T(3.0)
         mean_new = tr_new / T(3.0)
         eps_new = scale * (eps - mean * I) + mean_new * I
         D = eps_new - eps
@@ -322,12 +352,12 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
 
     @wp.func
     def update_any(H_tr: M, hzz: T, lj: T, kap: T, m: P):
-        eps, ezz, tr, dev2, ok, yld = small_strain(H_tr, hzz, lj, kap, m)
+        eps, ezz, tr, r, p0, ok, yld = small_strain(H_tr, hzz, lj, kap, m)
         if ok != 0:
             if yld == 0:
                 return H_tr, hzz, T(2.0) * m.mu * eps + (m.lam * tr) * wp.identity(dim, dtype=T), lj, kap, int(0)
             if wp.static(plastic and decomposition_free):
-                H_new, hzz_new, tau, lj_new, kap_new, flags, done = coaxial(H_tr, hzz, eps, ezz, tr, dev2, lj, kap, m)
+                H_new, hzz_new, tau, lj_new, kap_new, flags, done = coaxial(H_tr, hzz, eps, ezz, tr, r, p0, lj, kap, m)
                 if done != 0:
                     return H_new, hzz_new, tau, lj_new, kap_new, flags
         return general(H_tr, hzz, lj, kap, m)
