@@ -51,7 +51,7 @@ import warp as wp
 from .bonded_camclay import bonded_camclay_return_strain_func, bonded_p0_func
 from .camclay import camclay_p0_func, camclay_project_func, camclay_return_strain_func, camclay_yield_func
 from .elasticity import hencky_strain_func
-from .logstrain import expm1_func, expm1_sym_func, log1p_func, log_strain_func
+from .logstrain import expm1_func, expm1_small_func, expm1_sym_func, log1p_func, log_strain_func
 from .principal import principal_strain_func
 from .types import mat, vec
 
@@ -233,6 +233,7 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
     hencky_strain = hencky_strain_func(T)
     expm1 = expm1_func(T)
     expm1_sym = expm1_sym_func(T, dim)
+    expm1_small = expm1_small_func(T)
     sqrt6 = _SQRT6
 
     @wp.func
@@ -293,7 +294,7 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
         H_new = H_tr + expm1_sym(D) * (I + H_tr)
         hzz_new = hzz
         if wp.static(dim == 2):
-            hzz_new = hzz + (T(1.0) + hzz) * expm1(Dzz)
+            hzz_new = hzz + (T(1.0) + hzz) * expm1_small(Dzz)
         return H_new, hzz_new, T(2.0) * m.mu * eps_new + (m.lam * tr_new) * I, lj_new, kap_new, YIELDED, int(1)
 
     @wp.func

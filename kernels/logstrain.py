@@ -229,3 +229,24 @@ def expm1_sym_func(T, dim=3):
             return alpha * I + beta * D + gamma * D2
 
     return expm1_sym
+
+
+@functools.cache
+def expm1_small_func(T):
+    """Return ``expm1_small(x) -> exp(x) - 1`` for ``|x| <= 1/4`` by the series of :func:`expm1_sym_func` (Horner).
+
+    The scalar companion of ``expm1_sym`` (the out-of-plane entry of the same correction in
+    plane strain), a tenth of the cost of ``exp`` and ``log`` in :func:`expm1_func`.
+    """
+    order = 8 if T == wp.float32 else 13
+    inv_k = [1.0 / k for k in range(order, 1, -1)]  # 1/n, ..., 1/2 (Python floats, rounded once to T)
+
+    @wp.func
+    def expm1_small(x: T):
+        # x (1 + x/2 (1 + x/3 (... (1 + x/n))))
+        e = T(1.0)
+        for j in range(wp.static(order - 1)):  # unrolled: constant bounds
+            e = T(1.0) + (x * e) * T(wp.static(inv_k[j]))
+        return x * e
+
+    return expm1_small
