@@ -49,14 +49,14 @@ def compare_size(dim: int, n_grid: int, steps: int, threads: int, device: str, r
     cost = update_cost(sim)
     w["update_parts_s_per_step"] = cost
     step = w["s_per_step"] if device.startswith("cuda") else w["cpu_s_per_step"]  # same clock as update_cost
-    for part in ("update", "series_check", "principal", "return"):
+    for part in ("update", "principal_path_update", "series_check", "principal", "return"):
         w[f"{part}_share"] = cost[f"{part}_s"] / step
     out = {"dim": dim, "n_grid": n_grid, "n_particles": w["n_particles"], "threads": threads, "mpm_warp": w}
     print(f"mpm_warp {dim}D N {w['n_particles']:7d} threads {w['threads']}: {w['particle_steps_per_s'] / 1e6:6.3f} "
           f"M particle-steps/s; plasticity {w['plasticity_share']:.2f} of the step; alone: update "
-          f"{w['update_share']:.2f}, series check {w['series_check_share']:.2f}, eigen {w['principal_share']:.2f}, "
-          f"return {w['return_share']:.2f}; min yielded {min(k['yielded'] for k in w['return_kinds']):.3f}",
-          flush=True)
+          f"{w['update_share']:.2f} (with the eigen-decomposition {w['principal_path_update_share']:.2f}), "
+          f"series check {w['series_check_share']:.2f}, eigen {w['principal_share']:.2f}, return "
+          f"{w['return_share']:.2f}; min yielded {min(k['yielded'] for k in w['return_kinds']):.3f}", flush=True)
     if not taichi:
         return out
     arch = "cuda" if device.startswith("cuda") else "cpu"
