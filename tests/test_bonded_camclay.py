@@ -36,8 +36,7 @@ from mpm_warp.kernels.camclay import SINGULAR_VALUE_FLOOR, camclay_pq_func
 from mpm_warp.kernels.types import vec3
 from mpm_warp.material_point import drive_material_points, lame_parameters, strain_path
 from mpm_warp.materials import BondedCamClay
-from mpm_warp.model import seed_block
-from mpm_warp.scenes.weak_layer.calibration import layer_columns
+from mpm_warp.model import lattice_columns, lattice_counts, seed_block
 from mpm_warp.scenes.weak_layer.paths import drive_layer, simple_shear_path
 
 DEVICE = "cpu"
@@ -443,14 +442,17 @@ def test_no_cycling_converges_to_the_critical_state(dtype, dgamma):
 # ----------------------------------------------------------------------------- column averaging
 def test_layer_columns_of_a_seeded_layer():
     """A layer seeded by the engine's lattice: one column per bed position, the particles across the layer."""
-    x0, _ = seed_block((0.0, 0.0, 0.0), (0.3, 0.02, 0.01), 0.005, 2)  # 4 cells across, 2 particles per cell
-    col, n_col = layer_columns(x0)
+    lo, hi = (0.0, 0.0, 0.0), (0.3, 0.02, 0.01)
+    x0, _ = seed_block(lo, hi, 0.005, 2)  # 4 cells across, 2 particles per cell
+    col = lattice_columns(lattice_counts(lo, hi, 0.005, 2))
+    n_col = int(col.max()) + 1
     assert n_col == 120 * 4 and np.all(np.bincount(col) == 8)
     for j in (0, 7, n_col - 1):
         xs = x0[col == j]
         assert np.ptp(xs[:, 0]) == 0 and np.ptp(xs[:, 2]) == 0 and np.ptp(xs[:, 1]) > 0.015
-    with pytest.raises(InvalidArgument):
-        layer_columns(np.zeros((3, 2)))
+    x2, _ = seed_block(lo[:2], hi[:2], 0.005, 2)   # plane strain: one column per x
+    col2 = lattice_columns(lattice_counts(lo[:2], hi[:2], 0.005, 2))
+    assert int(col2.max()) + 1 == 120 and all(np.ptp(x2[col2 == j, 0]) == 0 for j in (0, 119))
 
 
 @pytest.mark.parametrize("dtype", list(TYPES))

@@ -36,12 +36,8 @@ import warp as wp
 from mpm_warp.errors import InvalidArgument, ScenarioError
 from mpm_warp.loader import material_from_table
 from mpm_warp.materials import BondedCamClay
-from mpm_warp.scenes.weak_layer.calibration import (
-    critical_cut_length,
-    heierli_anticrack,
-    weac_collapse_height,
-    weak_layer_material,
-)
+from mpm_warp.scenes.references import critical_cut_length_formula, weac_collapse_height
+from mpm_warp.scenes.weak_layer.calibration import heierli_anticrack, weak_layer_material
 from mpm_warp.scenes.weak_layer.paths import (
     collapse_law,
     compressive_strength,
@@ -202,7 +198,7 @@ def test_derived_predictions_and_summary(layer):
     assert layer.compressive_strength > SIGMA_N
     a_c = math.sqrt(2 * 1000.0 * 5e6 / (1 - 0.09) * 0.02 / (mat.mu * 250.0 * 9.81))
     assert abs(layer.critical_cut - a_c) < 1e-12 and 0.15 < a_c < 0.6
-    assert critical_cut_length(**layer.critical_cut_inputs) == layer.critical_cut
+    assert critical_cut_length_formula(**layer.critical_cut_inputs) == layer.critical_cut
     c, l_td = heierli_anticrack(5e6, 0.5, 200.0, 2e-3)  # the example of MODEL.md 6: about 34 m/s and 1.6 m
     assert abs(c - 33.6) < 0.05 and abs(l_td - 1.58) < 0.005
     assert layer.heierli_speed == heierli_anticrack(5e6, 0.5, 250.0, layer.h_c)[0]
