@@ -134,7 +134,8 @@ class _StderrLines(logging.Handler):
         sys.stderr.write(f"mpm-warp: {record.getMessage()}\n")
 
 
-def _summary(res, out=sys.stdout):
+def _summary(res, out=None):
+    out = out or sys.stdout
     out.write(
         f"done: {res.frames} frames, {res.steps} steps, t = {res.sim_time:.6g} s, {res.n_particles} particles on "
         f"{res.device}; stepping {res.wall_time:.2f} s ({res.particle_steps_per_s / 1e6:.2f} M particle-steps/s)"
@@ -156,7 +157,7 @@ def cmd_run(a) -> int:
     from .runner import run
 
     with StopRequest() as stop:
-        prog = Progress(math.inf, stop=stop, quiet=a.quiet)
+        prog = Progress(math.inf, stream=sys.stderr, stop=stop, quiet=a.quiet)
 
         def start(sim):
             prog.end = sim.scenario.time.end
@@ -179,7 +180,7 @@ def cmd_resume(a) -> int:
     from .runner import resume
 
     with StopRequest() as stop:
-        prog = Progress(math.inf, stop=stop, quiet=a.quiet)
+        prog = Progress(math.inf, stream=sys.stderr, stop=stop, quiet=a.quiet)
 
         def start(sim):
             prog.end = a.end if a.end is not None else sim.scenario.time.end

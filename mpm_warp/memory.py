@@ -82,8 +82,9 @@ class MemoryEstimate:
     grid : int
         Device bytes of the grid copies.
     host : int
-        Host bytes beside the state: seeded and initial positions (kept) and the initial fields
-        built before their upload.
+        Host bytes kept beside the state for the whole run: the seeded and the initial positions.
+    staging : int
+        Host bytes of the initial ``x``, ``v``, ``C`` built before their upload (freed after).
     """
 
     n_particles: int
@@ -92,11 +93,17 @@ class MemoryEstimate:
     grid_copies: int
     grid: int
     host: int
+    staging: int
 
     @property
     def device(self) -> int:
         """Device bytes: particles and grid."""
         return self.particles + self.grid
+
+    @property
+    def total(self) -> int:
+        """Everything: device, host and staging bytes (all host memory on the CPU)."""
+        return self.particles + self.grid + self.host + self.staging
 
 
 def estimate_memory(scenario: Scenario, device: str, n_threads: int | None = None) -> MemoryEstimate:
@@ -118,8 +125,8 @@ def estimate_memory(scenario: Scenario, device: str, n_threads: int | None = Non
     for c in shape:
         nodes *= c
     copies = grid_copies(device, n, shape, n_threads)
-    host = n * (2 * dim * 8 + (2 * dim + dim * dim) * s)
-    return MemoryEstimate(n, part, nodes, copies, copies * nodes * (1 + dim) * s, host)
+    return MemoryEstimate(n, part, nodes, copies, copies * nodes * (1 + dim) * s, n * 2 * dim * 8,
+                          n * (2 * dim + dim * dim) * s)
 
 
 def available_memory(device: str) -> tuple[int | None, int | None]:
@@ -145,9 +152,9 @@ def check_memory(scenario: Scenario, device: str, n_threads: int | None = None, 
     limit = None if max_memory is None else parse_bytes(max_memory)
     host_free, dev_free = available_memory(device)
     on_cpu = dev_free is None
-    checks = [(est.device + est.host if on_cpu else est.host, host_free, "MemAvailable"),
+    checks = [(est.total if on_cpu else est.host + est.staging, host_free, "MemAvailable"),
               (est.device, dev_free, f"free on {device}"),
-              (est.device + est.host, limit, "max_memory")]
+              (est.total, limit, "max_memory")]
     for need, have, what in checks:
         if have is not None and need > have:
             grid_heavy = est.grid > est.particles
@@ -156,7 +163,8 @@ def check_memory(scenario: Scenario, device: str, n_threads: int | None = None, 
             raise InvalidArgument(key, value, (
                 f"a scene that fits in memory: {format_bytes(need)} needed ({est.n_particles:.3g} particles "
                 f"{format_bytes(est.particles)}, grid {est.grid_copies} x {est.grid_nodes:.3g} nodes "
-                f"{format_bytes(est.grid)}, host {format_bytes(est.host)}), {format_bytes(have)} available "
+                f"{format_bytes(est.grid)}, host {format_bytes(est.host + est.staging)}), {format_bytes(have)} "
+                f"available "
                 f"({what}); " + ("shrink the domain or raise domain.dx" if grid_heavy else
                                  "raise domain.dx or shrink the blocks (or their particles_per_cell)")))
     return est

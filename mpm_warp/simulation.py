@@ -204,8 +204,9 @@ class Simulation:
             if floors or inversions:
                 t, dt, steps = self.stepper.clock()
                 raise SimulationBlowUp(steps, -1, "F", (
-                    f"{inversions} inversions (det F_tr <= 0) and {floors} singular-value floor events by t = "
-                    f"{t:.6g} s (output.on_inversion = 'stop'; 'report' runs on and counts them)"))
+                    f"{inversions} inversion{'s' * (inversions != 1)} (det F_tr <= 0) and {floors} singular-value "
+                    f"floor event{'s' * (floors != 1)} by t = {t:.6g} s (output.on_inversion = 'stop'; 'report' "
+                    "runs on and counts them)"))
 
     def step_to(self, t_end: float, health_every: int | None = None) -> int:
         """Advance to ``t_end`` (s) exactly; return the steps taken.
@@ -456,7 +457,7 @@ class Simulation:
             m.load_state({k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)})
         if "wall_impulses" in arrays and self.stepper.wall_impulses is not None:
             imp = arrays["wall_impulses"]
-            if imp.shape != self.stepper.wall_impulses.shape:   # another thread count: the sum in one slot
+            if imp.shape[:2] != self.stepper.wall_impulses.shape:   # another thread count: the sum in one slot
                 imp = np.concatenate([imp.sum(axis=0, keepdims=True),
                                       np.zeros((self.stepper.wall_impulses.shape[0] - 1, *imp.shape[1:]))])
             self.stepper.wall_impulses.assign(imp)
