@@ -370,6 +370,12 @@ def _one_line(text: str) -> str:
     pytest.param(BASE, ["time.cfl=abc"], ("time.cfl", "'abc'"), id="set-bad-value"),
     pytest.param(BASE, ["nonsense"], ("'nonsense'", "key=value"), id="set-no-equals"),
     pytest.param(BASE, ["time.cfll=0.3"], ("did you mean 'time.cfl'",), id="set-misspelt"),
+    pytest.param(BASE, ["domain.dx=5.0"], ("domain.dx = 5.0", "smallest block extent"), id="dx-5m"),
+    pytest.param(BASE, ["time.frame_interval=0.05"], ("time.frame_interval = 0.05", "at most time.end"),
+                 id="frame-interval-above-end"),
+    pytest.param(BASE, ["materials.snow.E=1e30"], ("1e+30", "at most 1e+08 steps", "9.17e+13 steps"), id="E-1e30"),
+    pytest.param(BASE, ["materials.snow.density=1e-300"], ("1e-300", "at most 1e+08 steps"), id="density-1e-300"),
+    pytest.param(BASE, ["blocks.0.velocity=[1e6, 0, 0]"], ("blocks[0].velocity", "Mach 1.36e+04"), id="v-1e6"),
 ])
 def test_cli_bad_input_one_line_exit_2(tmp_path, capsys, text, sets, needles):
     path = _write(tmp_path, text)

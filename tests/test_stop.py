@@ -146,6 +146,7 @@ def test_cli_signal_during_a_long_frame_stops_within_seconds_and_resumes_exactly
     assert proc.returncode == 130, err
     assert time.perf_counter() - t0 < 10.0
     assert "stopping after the current batch of steps" in err and "resume with" in err
+    assert not os.path.exists(io.lock.lock_path_for(out))                  # released on the way out
     meta = io.read_checkpoint_meta(io.checkpoint_path_for(out))
     assert meta["frame_index"] == 0 and 0.0 < meta["time"] < 0.8
     p = subprocess.run([sys.executable, "-m", "mpm_warp.cli", "resume", str(out)], capture_output=True, text=True,
