@@ -96,10 +96,12 @@ from .types import vec3
 __all__ = [
     "bond_func",
     "bonded_camclay_return_func",
+    "bonded_camclay_return_strain_func",
     "bonded_p0_func",
     "bonded_yield_func",
     "kappa_column_mean_kernel",
     "kappa_column_sum_kernel",
+    "column_sums_zero_kernel",
 ]
 
 _SQRT6 = math.sqrt(6.0)
@@ -342,6 +344,37 @@ def bonded_camclay_return_func(T):
     """
     v3 = vec3(T)
     s_floor = SINGULAR_VALUE_FLOOR
+    core = bonded_camclay_return_strain_func(T)
+
+    @wp.func
+    def bonded_camclay_return(sig: v3, log_jp: T, kappa: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T,
+                              p_bond: T, kappa_s: T):
+        sf = T(s_floor)
+        e = v3(wp.log(wp.max(sig[0], sf)), wp.log(wp.max(sig[1], sf)), wp.log(wp.max(sig[2], sf)))
+        e_new, lj_new, k_new, y = core(e, log_jp, kappa, mu, lam, M, beta, xi, p0_floor, p_bond, kappa_s)
+        if y == 0:
+            return sig, log_jp, kappa, y
+        return v3(wp.exp(e_new[0]), wp.exp(e_new[1]), wp.exp(e_new[2])), lj_new, k_new, y
+
+    return bonded_camclay_return
+
+
+@functools.cache
+def bonded_camclay_return_strain_func(T):
+    """Build the return in principal Hencky strains, the core of :func:`bonded_camclay_return_func`.
+
+    Signature of the returned ``wp.func``::
+
+        bonded_camclay_return_strain(eps: vec3, log_jp: T, kappa: T, mu: T, lam: T, M: T, beta: T, xi: T,
+                                     p0_floor: T, p_bond: T, kappa_s: T)
+            -> (eps_new: vec3, log_jp_new: T, kappa_new: T, yielded: int32)
+
+    ``eps`` are the principal Hencky strains of the trial (-), e.g. ``1/2 log1p`` of the
+    eigenvalues of ``F F^T - I`` (``kernels/constitutive.py``), which keeps the relative
+    precision of small strains; everything else as :func:`bonded_camclay_return_func`.
+    An elastic trial returns ``eps`` itself.
+    """
+    v3 = vec3(T)
     sqrt6 = _SQRT6
     eps = _eps(T)
     two_eps = 2.0 * eps
@@ -359,10 +392,8 @@ def bonded_camclay_return_func(T):
         return wp.sqrt(ed * ed + ev * ev / T(3.0))
 
     @wp.func
-    def bonded_camclay_return(sig: v3, log_jp: T, kappa: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T,
-                              p_bond: T, kappa_s: T):
-        sf = T(s_floor)
-        e = v3(wp.log(wp.max(sig[0], sf)), wp.log(wp.max(sig[1], sf)), wp.log(wp.max(sig[2], sf)))
+    def bonded_camclay_return_strain(e: v3, log_jp: T, kappa: T, mu: T, lam: T, M: T, beta: T, xi: T,
+                                     p0_floor: T, p_bond: T, kappa_s: T):
         tr = e[0] + e[1] + e[2]
         m = tr / T(3.0)
         dev = v3(e[0] - m, e[1] - m, e[2] - m)
@@ -373,7 +404,7 @@ def bonded_camclay_return_func(T):
         q_tr = T(sqrt6) * mu * wp.length(dev)
         p0, b_n = p0_fn(log_jp, kappa, K, xi, p0_floor, p_bond, kappa_s)
         if yield_fn(p_tr, q_tr, p0, M, beta * b_n) <= T(0.0):
-            return sig, log_jp, kappa, wp.int32(0)
+            return e, log_jp, kappa, wp.int32(0)
 
         L = log_jp
         p = p_tr
@@ -431,14 +462,15 @@ def bonded_camclay_return_func(T):
         if q_tr > T(0.0):
             scale = wp.min(q / q_tr, T(1.0))
         m_new = -p / (T(3.0) * K)
-        sig_new = v3(wp.exp(dev[0] * scale + m_new), wp.exp(dev[1] * scale + m_new),
-                     wp.exp(dev[2] * scale + m_new))
+        e_new = v3(dev[0] * scale + m_new, dev[1] * scale + m_new, dev[2] * scale + m_new)
         # bookkeeping from the stored strains themselves: d = eps_tr - eps_new
         dv = tr - T(3.0) * m_new
         dd = wp.length(dev) * (T(1.0) - scale)
-        return sig_new, log_jp + dv, kappa + wp.sqrt(dd * dd + dv * dv / T(3.0)), wp.int32(1)
+        return e_new, log_jp + dv, kappa + wp.sqrt(dd * dd + dv * dv / T(3.0)), wp.int32(1)
 
-    return bonded_camclay_return
+    return bonded_camclay_return_strain
+
+
 
 
 # ----------------------------------------------------------------------------- column averaging
@@ -458,7 +490,7 @@ def kappa_column_sum_kernel(T):
     this kernel, then :func:`kappa_column_mean_kernel`.
     """
 
-    @wp.kernel(enable_backward=False)
+    @wp.kernel(enable_backward=False, module="unique")
     def kappa_column_sum(kappa: wp.array(dtype=T), column: wp.array(dtype=wp.int32),
                          sums: wp.array(dtype=wp.vec2d)):
         i = wp.tid()
@@ -478,7 +510,7 @@ def kappa_column_mean_kernel(T):
     a second pass leaves ``kappa`` unchanged (exactly in float32).
     """
 
-    @wp.kernel(enable_backward=False)
+    @wp.kernel(enable_backward=False, module="unique")
     def kappa_column_mean(sums: wp.array(dtype=wp.vec2d), column: wp.array(dtype=wp.int32),
                           kappa: wp.array(dtype=T)):
         i = wp.tid()
@@ -486,3 +518,15 @@ def kappa_column_mean_kernel(T):
         kappa[i] = T(s[0] / s[1])
 
     return kappa_column_mean
+
+
+@functools.cache
+def column_sums_zero_kernel():
+    """Kernel ``column_sums_zero(sums)``: ``sums[c] = (0, 0)``, one thread per column (a recordable launch
+    that clears the buffer of :func:`kappa_column_sum_kernel` before every step's sums)."""
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def column_sums_zero(sums: wp.array(dtype=wp.vec2d)):
+        sums[wp.tid()] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
+
+    return column_sums_zero

@@ -40,16 +40,17 @@ import math
 
 import warp as wp
 
-from .camclay import SINGULAR_VALUE_FLOOR, camclay_p0_func, camclay_return_strain_func, camclay_yield_func
+from .bonded_camclay import bonded_camclay_return_strain_func, bonded_p0_func
+from .camclay import camclay_p0_func, camclay_return_strain_func, camclay_yield_func
 from .elasticity import hencky_strain_func
 from .logstrain import expm1_func, log1p_func, log_strain_func
+from .principal import principal_strain_func
 from .types import mat, vec
 
-__all__ = ["MODELS", "YIELDED", "FLOORED", "INVERTED", "material_struct", "trial_func", "svd2_func",
-           "sym_eig_func", "principal_func", "principal_strain_func", "constitutive_update_func"]
+__all__ = ["MODELS", "YIELDED", "FLOORED", "INVERTED", "material_struct", "trial_func", "constitutive_update_func"]
 
 #: material models with a kernel-side update
-MODELS = ("elastic", "camclay")
+MODELS = ("elastic", "camclay", "bonded_camclay")
 YIELDED = 1
 FLOORED = 2
 INVERTED = 4
@@ -63,7 +64,11 @@ def material_struct(T):
 
     Fields: ``mu``, ``lam`` (Lame parameters, Pa); ``M`` (critical-state slope, -);
     ``beta`` (cohesion ratio, -); ``xi`` (hardening factor, -); ``p0_floor`` (Pa);
-    ``s_floor`` (singular-value floor, -).
+    ``s_floor`` (singular-value floor, -); ``p_bond`` (bonded consolidation pressure, Pa) and
+    ``kappa_s`` (plastic strain at which the bond is gone, -) of the bonded weak layer;
+    ``log_jp_ref`` (-): the hardening state of the material as placed, so that the plastic change of
+    volume since then is ``exp(log_jp - log_jp_ref)`` (``log_jp`` starts at a consolidation's state,
+    not at 0) and the Cauchy stress is ``tau / (J_E exp(log_jp - log_jp_ref))``.
     """
 
     @wp.struct
@@ -75,6 +80,9 @@ def material_struct(T):
         xi: T
         p0_floor: T
         s_floor: T
+        p_bond: T
+        kappa_s: T
+        log_jp_ref: T
 
     return MaterialParams
 
@@ -92,170 +100,47 @@ def trial_func(T, dim=3):
 
 
 @functools.cache
-def svd2_func(T):
-    """Return ``svd2(F) -> (U, s, V)`` of a 2x2 matrix, ``F = U diag(s) V^T``.
-
-    ``U`` and ``V`` are rotations and ``s[1]`` carries the sign of ``det F``, the
-    convention of ``wp.svd3`` (``wp.svd2`` returns a reflection in ``U`` for
-    ``det F < 0`` and fails on symmetric reflections such as ``[[0, 1], [1, 0]]``).
-    Closed form: the polar rotation ``R`` of ``F = R S`` (angle ``atan2(F10 - F01,
-    F00 + F11)``), then the eigenvectors ``Q`` of the symmetric ``S``:
-    ``U = R Q``, ``V = Q``, ``s`` the eigenvalues of ``S``, descending.
-    """
-    M2 = mat(2, T)
-    V2 = vec(2, T)
-
-    @wp.func
-    def svd2(F: M2):
-        x = F[0, 0] + F[1, 1]
-        y = F[1, 0] - F[0, 1]
-        h = wp.sqrt(x * x + y * y)
-        c = T(1.0)
-        sn = T(0.0)
-        if h > T(0.0):
-            c = x / h
-            sn = y / h
-        R = M2(c, -sn, sn, c)
-        S = wp.transpose(R) * F
-        s12 = T(0.5) * (S[0, 1] + S[1, 0])
-        d = T(0.5) * (S[0, 0] - S[1, 1])
-        m = T(0.5) * (S[0, 0] + S[1, 1])
-        r = wp.sqrt(d * d + s12 * s12)
-        t = T(0.5) * wp.atan2(s12, d)
-        cq = wp.cos(t)
-        sq = wp.sin(t)
-        Q = M2(cq, -sq, sq, cq)
-        return R * Q, V2(m + r, m - r), Q
-
-    return svd2
-
-
-@functools.cache
-def sym_eig_func(T, dim=3):
-    """Return ``sym_eig(X) -> (Q, lam)``: eigenvectors (columns of ``Q``) and eigenvalues of a symmetric matrix.
-
-    3D: ``wp.eig3`` (Jacobi; eigenvalues to a few rounding units of ``|X|``). 2D:
-    closed form, ``lam = m +- r`` with ``m = tr/2``, ``r = sqrt(((X00 - X11)/2)^2 + X01^2)``,
-    ``Q`` the rotation by ``1/2 atan2(2 X01, X00 - X11)``.
-    """
-    M = mat(dim, T)
-    V = vec(dim, T)
-
-    @wp.func
-    def sym_eig(X: M):
-        if wp.static(dim == 2):
-            d = T(0.5) * (X[0, 0] - X[1, 1])
-            o = T(0.5) * (X[0, 1] + X[1, 0])
-            m = T(0.5) * (X[0, 0] + X[1, 1])
-            r = wp.sqrt(d * d + o * o)
-            t = T(0.5) * wp.atan2(o, d)
-            c = wp.cos(t)
-            sn = wp.sin(t)
-            return M(c, -sn, sn, c), V(m + r, m - r)
-        else:
-            Q = M()
-            lam = V()
-            wp.eig3(X, Q, lam)
-            return Q, lam
-
-    return sym_eig
-
-
-@functools.cache
-def principal_func(T, dim=3):
-    """Return ``principal(H, h_zz) -> (U, s: vec3, V)``: SVD of ``F_E = I + H`` (``dim x dim`` ``U``, ``V``).
-
-    In 3D ``h_zz`` is ignored; in plane strain ``s[2] = 1 + h_zz``. The last
-    in-plane singular value carries the sign of ``det`` (rotations ``U``, ``V``).
-    """
-    M = mat(dim, T)
-    V3 = vec(3, T)
-    svd2 = svd2_func(T)
-
-    @wp.func
-    def principal(H: M, hzz: T):
-        F = wp.identity(dim, dtype=T) + H
-        if wp.static(dim == 2):
-            U, s2, Vm = svd2(F)
-            return U, V3(s2[0], s2[1], T(1.0) + hzz), Vm
-        else:
-            U = M()
-            s = V3()
-            Vm = M()
-            wp.svd3(F, U, s, Vm)
-            return U, s, Vm
-
-    return principal
-
-
-@functools.cache
-def principal_strain_func(T, dim=3):
-    """Return ``principal_strain(H, h_zz, s_floor) -> (U, eps: vec3, Vm, s: vec3, svd: int)``.
-
-    Principal Hencky strains ``eps`` and left singular vectors ``U`` of
-    ``F_E = I + H`` (plane strain: ``eps[2] = log1p(h_zz)``). Normally from the
-    eigen-decomposition of ``X = F F^T - I = H + H^T + H H^T``:
-    ``eps_i = 1/2 log1p(lambda_i)``, which keeps the relative precision of a
-    strain of 1e-6 in float32 (the SVD of ``I + H`` resolves strains only to a
-    rounding unit of 1); then ``svd = 0`` and ``Vm``, ``s`` are not computed. A
-    stretch below 1e-2 or ``det F <= 0`` takes the SVD (``svd = 1``): ``s`` the
-    signed singular values, ``eps = ln max(s, s_floor)``.
-    """
-    M = mat(dim, T)
-    V3 = vec(3, T)
-    sym_eig = sym_eig_func(T, dim)
-    principal = principal_func(T, dim)
-    log1p = log1p_func(T)
-
-    @wp.func
-    def principal_strain(H: M, hzz: T, s_floor: T):
-        det = wp.determinant(wp.identity(dim, dtype=T) + H)
-        if wp.static(dim == 2):
-            det = det * (T(1.0) + hzz)
-        if det > T(0.0):
-            Q, lam = sym_eig(H + wp.transpose(H) + H * wp.transpose(H))
-            lam_min = lam[0]
-            for a in range(dim):
-                lam_min = wp.min(lam_min, lam[a])
-            if lam_min > T(-0.9999):
-                eps = V3()
-                for a in range(dim):
-                    eps[a] = T(0.5) * log1p(lam[a])
-                if wp.static(dim == 2):
-                    eps[2] = log1p(hzz)
-                return Q, eps, M(), V3(), int(0)
-        U, s, Vm = principal(H, hzz)
-        eps = V3(wp.log(wp.max(s[0], s_floor)), wp.log(wp.max(s[1], s_floor)), wp.log(wp.max(s[2], s_floor)))
-        return U, eps, Vm, s, int(1)
-
-    return principal_strain
-
-
-@functools.cache
 def _model_funcs(T, model):
     """``(yield_check, principal_return)`` of a plastic model (None, None for elastic).
 
-    ``yield_check(p, q, lj, mat) -> y`` (> 0 outside the surface);
-    ``principal_return(eps, lj, mat) -> (eps_new, lj_new, yielded)`` in principal Hencky strains.
+    ``yield_check(p, q, lj, kappa, mat) -> y`` (> 0 outside the surface);
+    ``principal_return(eps, lj, kappa, mat) -> (eps_new, lj_new, kappa_new, yielded)`` in principal
+    Hencky strains. Cam-Clay carries ``kappa`` through unchanged.
     """
     if model == "elastic":
         return None, None
-    if model != "camclay":
+    if model not in MODELS:
         raise ValueError(f"unknown material model {model!r}; expected one of {MODELS}")
     P = material_struct(T)
     V3 = vec(3, T)
-    p0f = camclay_p0_func(T)
     yf = camclay_yield_func(T)
-    ret = camclay_return_strain_func(T)
+    if model == "camclay":
+        p0f = camclay_p0_func(T)
+        ret = camclay_return_strain_func(T)
 
-    @wp.func
-    def yield_check(p: T, q: T, lj: T, m: P):
-        K = m.lam + (T(2.0) / T(3.0)) * m.mu
-        return yf(p, q, p0f(lj, K, m.xi, m.p0_floor), m.M, m.beta)
+        @wp.func
+        def yield_check(p: T, q: T, lj: T, kappa: T, m: P):
+            K = m.lam + (T(2.0) / T(3.0)) * m.mu
+            return yf(p, q, p0f(lj, K, m.xi, m.p0_floor), m.M, m.beta)
 
-    @wp.func
-    def principal_return(eps: V3, lj: T, m: P):
-        return ret(eps, lj, m.mu, m.lam, m.M, m.beta, m.xi, m.p0_floor)
+        @wp.func
+        def principal_return(eps: V3, lj: T, kappa: T, m: P):
+            e, l2, y = ret(eps, lj, m.mu, m.lam, m.M, m.beta, m.xi, m.p0_floor)
+            return e, l2, kappa, y
+
+    else:
+        bp0 = bonded_p0_func(T)
+        bret = bonded_camclay_return_strain_func(T)
+
+        @wp.func
+        def yield_check(p: T, q: T, lj: T, kappa: T, m: P):
+            K = m.lam + (T(2.0) / T(3.0)) * m.mu
+            p0, b = bp0(lj, kappa, K, m.xi, m.p0_floor, m.p_bond, m.kappa_s)
+            return yf(p, q, p0, m.M, m.beta * b)
+
+        @wp.func
+        def principal_return(eps: V3, lj: T, kappa: T, m: P):
+            return bret(eps, lj, kappa, m.mu, m.lam, m.M, m.beta, m.xi, m.p0_floor, m.p_bond, m.kappa_s)
 
     return yield_check, principal_return
 
@@ -266,8 +151,8 @@ def constitutive_update_func(dim, T, model):
 
     Signatures of the returned ``wp.func`` (``mat``/``vec`` of size ``dim``)::
 
-        3D: update(H_tr, log_jp, m) -> (H_new, tau, log_jp_new, flags)
-        2D: update(H_tr, hzz_tr, log_jp, m) -> (H_new, hzz_new, tau, log_jp_new, flags)
+        3D: update(H_tr, log_jp, kappa, m) -> (H_new, tau, log_jp_new, kappa_new, flags)
+        2D: update(H_tr, hzz_tr, log_jp, kappa, m) -> (H_new, hzz_new, tau, log_jp_new, kappa_new, flags)
 
     Parameters
     ----------
@@ -277,13 +162,15 @@ def constitutive_update_func(dim, T, model):
         Out-of-plane trial stretch minus one (-), plane strain only.
     log_jp : T
         Hardening state ``ln det F_P`` (-); passed through by elastic models.
+    kappa : T
+        Accumulated plastic strain of the bonded weak layer (-); passed through by the other models.
     m : MaterialParams
         See :func:`material_struct`.
 
     Returns
     -------
     H_new, hzz_new : new elastic state (-); ``tau`` : in-plane (2D) or full (3D)
-    Kirchhoff stress (Pa, tension positive); ``log_jp_new``; ``flags`` : bits
+    Kirchhoff stress (Pa, tension positive); ``log_jp_new``, ``kappa_new``; ``flags`` : bits
     :data:`YIELDED`, :data:`FLOORED`, :data:`INVERTED`.
     """
     M = mat(dim, T)
@@ -299,7 +186,7 @@ def constitutive_update_func(dim, T, model):
     sqrt6 = _SQRT6
 
     @wp.func
-    def small_strain(H_tr: M, hzz: T, lj: T, m: P):
+    def small_strain(H_tr: M, hzz: T, lj: T, kap: T, m: P):
         """Hencky strain by the series, and whether it applies (small, elastic, not inverted)."""
         eps, ok = log_strain(H_tr)
         ezz = T(0.0)
@@ -318,25 +205,27 @@ def constitutive_update_func(dim, T, model):
                 if wp.static(dim == 2):
                     dev2 = dev2 + (ezz - mean) * (ezz - mean)
                 K = m.lam + (T(2.0) / T(3.0)) * m.mu
-                if yield_check(-K * tr, T(sqrt6) * m.mu * wp.sqrt(dev2), lj, m) > T(0.0):
+                if yield_check(-K * tr, T(sqrt6) * m.mu * wp.sqrt(dev2), lj, kap, m) > T(0.0):
                     ok = 0
         return eps, tr, ok
 
     @wp.func
-    def strain_update(eps: V3, lj: T, m: P):
+    def strain_update(eps: V3, lj: T, kap: T, m: P):
         """Return mapping (plastic models) and Kirchhoff principal stresses of the new strains."""
         eps_new = eps
         lj_new = lj
+        kap_new = kap
         y = int(0)
         if wp.static(plastic):
-            e2, l2, yy = principal_return(eps, lj, m)
+            e2, l2, k2, yy = principal_return(eps, lj, kap, m)
             eps_new = e2
             lj_new = l2
+            kap_new = k2
             y = int(yy)
-        return eps_new, lj_new, y, hencky_strain(eps_new, m.mu, m.lam)
+        return eps_new, lj_new, kap_new, y, hencky_strain(eps_new, m.mu, m.lam)
 
     @wp.func
-    def general(H_tr: M, hzz: T, lj: T, m: P):
+    def general(H_tr: M, hzz: T, lj: T, kap: T, m: P):
         """Principal-strain path: principal strains, return mapping, state as a correction of the trial, stress."""
         I = wp.identity(dim, dtype=T)
         U, eps, Vm, s, svd = principal_strain(H_tr, hzz, m.s_floor)
@@ -350,7 +239,7 @@ def constitutive_update_func(dim, T, model):
                 flags = FLOORED
                 if s[1] <= T(0.0) or s[2] <= T(0.0):
                     flags = flags | INVERTED
-        eps_new, lj_new, y, tau_p = strain_update(eps, lj, m)
+        eps_new, lj_new, kap_new, y, tau_p = strain_update(eps, lj, kap, m)
         if y != 0:
             flags = flags | YIELDED
         H_new = H_tr
@@ -372,30 +261,25 @@ def constitutive_update_func(dim, T, model):
         Dt = M()
         for a in range(dim):
             Dt[a, a] = tau_p[a]
-        return H_new, hzz_new, U * Dt * wp.transpose(U), lj_new, flags
+        return H_new, hzz_new, U * Dt * wp.transpose(U), lj_new, kap_new, flags
 
     if dim == 2:
 
         @wp.func
-        def update(H_tr: M, hzz: T, lj: T, m: P):
-            eps, tr, ok = small_strain(H_tr, hzz, lj, m)
+        def update(H_tr: M, hzz: T, lj: T, kap: T, m: P):
+            eps, tr, ok = small_strain(H_tr, hzz, lj, kap, m)
             if ok != 0:
-                return H_tr, hzz, T(2.0) * m.mu * eps + (m.lam * tr) * wp.identity(dim, dtype=T), lj, int(0)
-            return general(H_tr, hzz, lj, m)
+                return H_tr, hzz, T(2.0) * m.mu * eps + (m.lam * tr) * wp.identity(dim, dtype=T), lj, kap, int(0)
+            return general(H_tr, hzz, lj, kap, m)
 
     else:
 
         @wp.func
-        def update(H_tr: M, lj: T, m: P):
-            eps, tr, ok = small_strain(H_tr, T(0.0), lj, m)
+        def update(H_tr: M, lj: T, kap: T, m: P):
+            eps, tr, ok = small_strain(H_tr, T(0.0), lj, kap, m)
             if ok != 0:
-                return H_tr, T(2.0) * m.mu * eps + (m.lam * tr) * wp.identity(dim, dtype=T), lj, int(0)
-            H_new, hzz_new, tau, lj_new, flags = general(H_tr, T(0.0), lj, m)
-            return H_new, tau, lj_new, flags
+                return H_tr, T(2.0) * m.mu * eps + (m.lam * tr) * wp.identity(dim, dtype=T), lj, kap, int(0)
+            H_new, hzz_new, tau, lj_new, kap_new, flags = general(H_tr, T(0.0), lj, kap, m)
+            return H_new, tau, lj_new, kap_new, flags
 
     return update
-
-
-def singular_value_floor() -> float:
-    """The engine's singular-value floor (dimensionless): see ``kernels/camclay.py``."""
-    return SINGULAR_VALUE_FLOOR

@@ -3,7 +3,7 @@
 None of these run inside the substep loop except the health check, which the
 driver launches every few steps. Each is built per (dimension, scalar type);
 the elastic state is ``H = F_E - I`` (and ``h_zz`` in plane strain), read
-through ``kernels.constitutive.principal_func``. Energies and stresses are
+through ``kernels.principal.principal_strain_func``. Energies and stresses are
 evaluated in float64 from the stored state whatever its precision (they run
 once per frame): ``I + H`` rounded to float32 would add a rounding of its own
 to the state's.
@@ -13,8 +13,9 @@ import functools
 
 import warp as wp
 
-from .constitutive import material_struct, principal_strain_func
+from .constitutive import material_struct
 from .elasticity import hencky_strain_energy_func, hencky_strain_func
+from .principal import principal_strain_func
 from .types import mat, vec
 
 INT_MAX = 2147483647
@@ -54,10 +55,11 @@ def energy_kernel(dim, T):
 
 @functools.cache
 def stress_kernel(dim, T):
-    """Cauchy stress ``sigma = tau / J_E`` (Pa, 3x3, tension positive), pressure ``p = -tr(tau)/3`` and Mises
+    """Cauchy stress ``sigma = tau / J`` (Pa, 3x3, tension positive), pressure ``p = -tr(tau)/3`` and Mises
     ``q = sqrt(3/2)|dev tau|`` (Pa, Kirchhoff, compression positive) of one group.
 
-    In plane strain ``sigma`` holds the in-plane block and ``sigma_zz`` (the
+    ``J = J_E exp(log_jp - log_jp_ref)`` is the volume ratio since the material was placed (``log_jp``
+    an empty array for elastic groups). In plane strain ``sigma`` holds the in-plane block and ``sigma_zz`` (the
     out-of-plane stress the constraint ``F_zz = 1`` carries); ``sigma_xz =
     sigma_yz = 0``. Any of the outputs may be None-sized arrays not written.
     """
@@ -71,7 +73,7 @@ def stress_kernel(dim, T):
     hencky = hencky_strain_func(D)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def stress(H: wp.array(dtype=M), hzz: wp.array(dtype=T), m: P, want_sigma: int,
+    def stress(H: wp.array(dtype=M), hzz: wp.array(dtype=T), log_jp: wp.array(dtype=T), m: P, want_sigma: int,
                p_out: wp.array(dtype=T), q_out: wp.array(dtype=T), sigma_out: wp.array(dtype=M3)):
         i = wp.tid()
         h = D(0.0)
@@ -85,7 +87,11 @@ def stress_kernel(dim, T):
         p_out[i] = T(p)
         q_out[i] = T(wp.sqrt(D(1.5) * wp.dot(dev, dev)))
         if want_sigma != 0:
-            J = wp.exp(eps[0] + eps[1] + eps[2])  # J_E of the floored stretches
+            # volume ratio since the material was placed: J_E (of the floored stretches) times the plastic change
+            ln_j = eps[0] + eps[1] + eps[2]
+            if log_jp.shape[0] > 0:
+                ln_j += D(log_jp[i]) - D(m.log_jp_ref)
+            J = wp.exp(ln_j)
             sig = M3()
             for a in range(dim):
                 for b in range(dim):

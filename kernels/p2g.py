@@ -39,7 +39,7 @@ def p2g_kernel(dim, T, model, track_yield):
         ``wp.float32`` or ``wp.float64``.
     model : str
         Material model of the group (see ``kernels.constitutive.MODELS``); plastic
-        models read and write ``log_jp``.
+        models read and write ``log_jp``, the bonded weak layer also ``kappa``.
     track_yield : bool
         Also set ``yielded[i] = 1`` where the return was active (output field).
     """
@@ -52,6 +52,7 @@ def p2g_kernel(dim, T, model, track_yield):
     trial = trial_func(T, dim)
     update = constitutive_update_func(dim, T, model)
     plastic = model != "elastic"
+    bonded = model == "bonded_camclay"
 
     @wp.kernel(enable_backward=False, module="unique")
     def p2g(
@@ -61,6 +62,7 @@ def p2g_kernel(dim, T, model, track_yield):
         H: wp.array(dtype=M),
         hzz: wp.array(dtype=T),
         log_jp: wp.array(dtype=T),
+        kappa: wp.array(dtype=T),
         yielded: wp.array(dtype=wp.uint8),
         mass: T,
         vol0: T,
@@ -81,18 +83,23 @@ def p2g_kernel(dim, T, model, track_yield):
         Cp = C[i]
         H_tr = trial(H[i], dt * Cp)
         lj = T(0.0)
+        kap = T(0.0)
         if wp.static(plastic):
             lj = log_jp[i]
+        if wp.static(bonded):
+            kap = kappa[i]
         if wp.static(dim == 2):
-            H_new, hzz_new, tau, lj_new, flags = update(H_tr, hzz[i], lj, m)
+            H_new, hzz_new, tau, lj_new, kap_new, flags = update(H_tr, hzz[i], lj, kap, m)
             hzz[i] = hzz_new
         else:
-            H_new, tau, lj_new, flags = update(H_tr, lj, m)
+            H_new, tau, lj_new, kap_new, flags = update(H_tr, lj, kap, m)
         H[i] = H_new
         if flags != 0:
             if wp.static(plastic):
                 if (flags & YIELDED) != 0:
                     log_jp[i] = lj_new
+                    if wp.static(bonded):
+                        kappa[i] = kap_new
                     if wp.static(track_yield):
                         yielded[i] = wp.uint8(1)
             if (flags & FLOORED) != 0:

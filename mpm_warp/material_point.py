@@ -20,16 +20,13 @@ Stresses: ``p``, ``q`` Kirchhoff, compression positive (MODEL.md 1); ``stress``
 Cauchy ``tau / J_E``, tension positive.
 """
 
-
-import functools
-
 import numpy as np
 import warp as wp
 
 from .errors import InvalidArgument
-from .kernels.camclay import SINGULAR_VALUE_FLOOR, camclay_p0_func
-from .kernels.constitutive import constitutive_update_func, material_struct, principal_strain_func, trial_func
-from .kernels.elasticity import hencky_strain_func
+from .kernels.camclay import SINGULAR_VALUE_FLOOR
+from .kernels.constitutive import material_struct
+from .kernels.material_point import drive_kernel
 from .kernels.types import mat, vec
 from .materials import CamClaySnow, Elastic, lame_parameters
 from .model import material_params
@@ -37,140 +34,6 @@ from .model import material_params
 __all__ = ["drive_material_points", "isotropic_compression", "lame_parameters", "strain_path"]
 
 _DTYPES = {"float32": (wp.float32, np.float32), "float64": (wp.float64, np.float64)}
-_MAX_CONTROL_ITERATIONS = 60
-
-
-@functools.cache
-def _drive_kernel(dim, T, model):
-    """One thread per material point, looping over its increments."""
-    M = mat(dim, T)
-    M3 = mat(3, T)
-    V3 = vec(3, T)
-    Vd = vec(dim, T)
-    P = material_struct(T)
-    update = constitutive_update_func(dim, T, model)
-    trial = trial_func(T, dim)
-    D = wp.float64
-    MD = mat(dim, D)
-    principal64 = principal_strain_func(D, dim)
-    hencky64 = hencky_strain_func(D)
-    p0f = camclay_p0_func(T)
-    plastic = model != "elastic"
-    max_it = _MAX_CONTROL_ITERATIONS
-
-    @wp.func
-    def step(H: M, hzz: T, lj: T, L: M, m: P):
-        H_tr = trial(H, L)
-        hzz_tr = hzz
-        if wp.static(dim == 2):
-            H_new, hzz_new, tau, lj_new, flags = update(H_tr, hzz, lj, m)
-            return H_tr, hzz_tr, H_new, hzz_new, lj_new, flags
-        else:
-            H_new, tau, lj_new, flags = update(H_tr, lj, m)
-            return H_tr, hzz_tr, H_new, hzz, lj_new, flags
-
-    @wp.func
-    def cauchy(H: M, hzz: T, m: P):
-        """Cauchy stress, principal stretches and Kirchhoff stresses of a state, evaluated in float64 (outputs
-        and stress control measure the stored state, not a float32 re-rounding of ``I + H``)."""
-        U, eps, Vm, s, svd = principal64(MD(H), D(hzz), D(m.s_floor))
-        tau = hencky64(eps, D(m.mu), D(m.lam))
-        J = wp.exp(eps[0] + eps[1] + eps[2])
-        sig = M3()
-        for a in range(dim):
-            for b in range(dim):
-                acc = D(0.0)
-                for k in range(dim):
-                    acc += U[a, k] * tau[k] * U[b, k]
-                sig[a, b] = T(acc / J)
-        if wp.static(dim == 2):
-            sig[2, 2] = T(tau[2] / J)
-        return sig, V3(eps), V3(tau)
-
-    @wp.kernel(enable_backward=False, module="unique")
-    def drive(L_path: wp.array2d(dtype=M), params: wp.array(dtype=P), H0: wp.array(dtype=M), hzz0: wp.array(dtype=T),
-              lj0: wp.array(dtype=T), control: wp.array2d(dtype=T), stress_tol: wp.array(dtype=T),
-              H_out: wp.array2d(dtype=M), hzz_out: wp.array2d(dtype=T), lj_out: wp.array2d(dtype=T),
-              yielded: wp.array2d(dtype=wp.int32), eps_trial: wp.array2d(dtype=V3), eps: wp.array2d(dtype=V3),
-              sigma: wp.array2d(dtype=M3), p_out: wp.array2d(dtype=T), q_out: wp.array2d(dtype=T),
-              p0_out: wp.array2d(dtype=T), L_used: wp.array2d(dtype=M), residual: wp.array2d(dtype=T)):
-        i = wp.tid()
-        m = params[i]
-        K = m.lam + (T(2.0) / T(3.0)) * m.mu
-        H = H0[i]
-        hzz = hzz0[i]
-        lj = lj0[i]
-        H_out[i, 0] = H
-        hzz_out[i, 0] = hzz
-        lj_out[i, 0] = lj
-        sig, e0, tau = cauchy(H, hzz, m)
-        sigma[i, 0] = sig
-        eps[i, 0] = e0
-        eps_trial[i, 0] = e0
-        p = -(tau[0] + tau[1] + tau[2]) / T(3.0)
-        p_out[i, 0] = p
-        dv = tau + V3(p, p, p)
-        q_out[i, 0] = wp.sqrt(T(1.5) * wp.dot(dv, dv))
-        if wp.static(plastic):
-            p0_out[i, 0] = p0f(lj, K, m.xi, m.p0_floor)
-        # control[i] = (mask_0..mask_{dim-1}, target_0..target_{dim-1}); elastic tangent on the controlled axes
-        n_ctl = int(0)
-        Jac = M()
-        for a in range(dim):
-            if control[i, a] != T(0.0):
-                n_ctl += 1
-            for b in range(dim):
-                if control[i, a] != T(0.0) and control[i, b] != T(0.0):
-                    Jac[a, b] = m.lam
-                    if a == b:
-                        Jac[a, b] = m.lam + T(2.0) * m.mu
-                elif a == b:
-                    Jac[a, b] = T(1.0)
-        Jinv = wp.inverse(Jac)
-        for k in range(L_path.shape[1]):
-            L = L_path[i, k]
-            H_tr, hzz_tr, H_new, hzz_new, lj_new, flags = step(H, hzz, lj, L, m)
-            res = T(0.0)
-            if n_ctl > 0:
-                it = int(0)
-                while it < max_it:
-                    sig, e_it, tau = cauchy(H_new, hzz_new, m)
-                    r = Vd()
-                    res = T(0.0)
-                    for a in range(dim):
-                        if control[i, a] != T(0.0):
-                            r[a] = sig[a, a] - control[i, dim + a]
-                            res = wp.max(res, wp.abs(r[a]))
-                    if res <= stress_tol[0]:
-                        break
-                    dl = Jinv * r
-                    for a in range(dim):
-                        if control[i, a] != T(0.0):
-                            L[a, a] = L[a, a] - dl[a]
-                    H_tr, hzz_tr, H_new, hzz_new, lj_new, flags = step(H, hzz, lj, L, m)
-                    it += 1
-            residual[i, k + 1] = res
-            L_used[i, k] = L
-            sig_t, e_t, tau_t = cauchy(H_tr, hzz_tr, m)
-            eps_trial[i, k + 1] = e_t
-            H = H_new
-            hzz = hzz_new
-            lj = lj_new
-            H_out[i, k + 1] = H
-            hzz_out[i, k + 1] = hzz
-            lj_out[i, k + 1] = lj
-            yielded[i, k + 1] = flags & 1
-            sig, e_k, tau = cauchy(H, hzz, m)
-            sigma[i, k + 1] = sig
-            eps[i, k + 1] = e_k
-            p = -(tau[0] + tau[1] + tau[2]) / T(3.0)
-            p_out[i, k + 1] = p
-            dv = tau + V3(p, p, p)
-            q_out[i, k + 1] = wp.sqrt(T(1.5) * wp.dot(dv, dv))
-            if wp.static(plastic):
-                p0_out[i, k + 1] = p0f(lj, K, m.xi, m.p0_floor)
-
-    return drive
 
 
 def _materials(material, n_points: int, legacy: dict) -> list[Elastic]:
@@ -208,7 +71,18 @@ def _materials(material, n_points: int, legacy: dict) -> list[Elastic]:
     return out
 
 
-def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None, log_jp0=None,
+def _per_point(name: str, given, default, lo=None) -> np.ndarray:
+    """One finite value per point (float64): ``given`` broadcast, or ``default`` when None."""
+    n = len(default)
+    a = np.asarray(default if given is None else np.broadcast_to(np.asarray(given, dtype=np.float64), (n,)),
+                   dtype=np.float64).copy()
+    if not np.all(np.isfinite(a)) or (lo is not None and np.any(a < lo)):
+        raise InvalidArgument(name, given, "finite values" + (f" >= {lo:g}" if lo is not None else ""))
+    return a
+
+
+def drive_material_points(F_path=None, *, L_path=None, F_total=None, material=None, F_E0=None, log_jp0=None,
+                          kappa0=None,
                           stress_control=None, stress_tol=None, dtype="float32", device=None,
                           E=None, nu=None, M=None, beta=None, xi=None, p0_ini=0.0, p0_floor=None) -> dict:
     """Run the engine's constitutive update on independent material points along prescribed paths.
@@ -222,22 +96,29 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
     L_path : array_like, same shapes
         The increments ``L = dt grad v`` (-) directly, instead of ``F_path``: a particle's
         ``dt C`` gives the engine's update bit for bit.
-    material : Elastic, CamClaySnow, or a list of them (one per point, one model)
+    F_total : array_like, same shapes
+        The total deformation gradients reached after each increment (-), relative to the start,
+        instead of increments: ``L = F_k F_{k-1}^-1 - I``, formed in the kernel. Under stress control
+        the controlled diagonal entries are solved (their given values are ignored).
+    material : Elastic, CamClaySnow, BondedCamClay, or a list of them (one per point, one model)
         The material; or give the Cam-Clay parameters as keywords ``E, nu, M, beta, xi,
         p0_ini, p0_floor`` (Pa, -, -, -, -, Pa, Pa).
     F_E0 : array_like, shape (3, 3) or (n_points, 3, 3), optional
         Initial elastic deformation gradient (-), default ``I``. In plane strain the
         in-plane block and ``F_zz`` are used.
-    log_jp0 : float or array_like (n_points,), optional
-        Initial ``ln det F_P`` (-); default from each material's ``p0_ini``.
+    log_jp0, kappa0 : float or array_like (n_points,), optional
+        Initial ``ln det F_P`` (-) and accumulated plastic strain of a bonded weak layer (-);
+        default each material's initial state (``p0_ini``; an intact bond).
     stress_control : dict, optional
         ``{"axes": (bool,) * d, "sigma": (float,) * d}`` (one for all points, or arrays of
         shape (n_points, d)): on the axes marked True the normal Cauchy stress (Pa,
-        tension positive) is held at ``sigma`` and the matching diagonal entries of ``L``
-        are solved for at every increment (their given values are the first guess).
+        tension positive; ``tau / (J_E J_P)``) is held at ``sigma`` and the matching diagonal
+        entries of ``L`` (of ``ln F`` for ``F_total``) are solved for at every increment; see
+        :mod:`mpm_warp.kernels.material_point` (one axis: a bracketing search that follows a
+        collapse; several: Newton iterations).
     stress_tol : float, optional
-        Tolerance on the controlled stresses (Pa); default ``1e-7 (lam + 2 mu)`` in float64,
-        ``2e-6 (lam + 2 mu)`` in float32 (a few rounding units of strain).
+        Tolerance on the controlled stresses (Pa); default ``1e-12 (lam + 2 mu)`` in float64,
+        ``2.5e-7 (lam + 2 mu)`` in float32 (four rounding units of strain).
     dtype : {"float32", "float64"}
     device : str or None
         Warp device; None means Warp's default device.
@@ -246,11 +127,14 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
     -------
     dict of numpy.ndarray, index 0 the initial state, shape ``(n_points, n_increments + 1, ...)``
         ``F_E`` (..., 3, 3); ``H`` (..., d, d) and, in plane strain, ``hzz``: the stored elastic
-        state ``F_E - I`` in the driver's precision (the engine's particle state); ``log_jp``;
+        state ``F_E - I`` in the driver's precision (the engine's particle state); ``log_jp``
+        (and ``kappa`` for the bonded weak layer);
         ``p``, ``q`` (Pa, Kirchhoff, compression positive); ``p0`` (Pa; Cam-Clay); ``stress``
         (..., 3, 3) Cauchy (Pa); ``eps_trial``, ``eps`` (..., 3): principal Hencky strains of the
         trial and of the new state (in-plane first, then zz in 2D); ``yielded`` (int32);
-        ``L`` (n_points, n_increments, d, d) the increments used (solved entries included);
+        ``L`` (n_points, n_increments, d, d) the increments used (solved entries included); ``F``
+        (..., 3, 3) the total deformation gradient since the start; ``tau`` (..., 3, 3) Kirchhoff (Pa);
+        ``bond`` (bonded weak layer: ``max(0, 1 - kappa/kappa_s)``);
         ``control_residual`` (Pa, the largest controlled-stress error left at each increment).
 
     Raises
@@ -261,10 +145,10 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
     if dtype not in _DTYPES:
         raise InvalidArgument("dtype", dtype, f"one of {sorted(_DTYPES)}")
     T, np_t = _DTYPES[dtype]
-    if (F_path is None) == (L_path is None):
-        raise InvalidArgument("F_path/L_path", "both" if F_path is not None else "neither", "exactly one of them")
-    name = "F_path" if F_path is not None else "L_path"
-    given = F_path if F_path is not None else L_path
+    paths = {k: v for k, v in (("F_path", F_path), ("L_path", L_path), ("F_total", F_total)) if v is not None}
+    if len(paths) != 1:
+        raise InvalidArgument("F_path/L_path/F_total", sorted(paths) or "none", "exactly one of them")
+    (name, given), = paths.items()
     A = np.asarray(given, dtype=np.float64)
     if A.ndim == 3:
         A = A[None]
@@ -274,7 +158,7 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
     if not np.all(np.isfinite(A)):
         raise InvalidArgument(name, "array with non-finite entries", "finite entries")
     n_pts, n_inc, dim = A.shape[0], A.shape[1], A.shape[2]
-    L = A - np.eye(dim) if F_path is not None else A
+    L = A - np.eye(dim) if F_path is not None else A     # F_total: the total gradients, passed as they are
     mats = _materials(material, n_pts, dict(E=E, nu=nu, M=M, beta=beta, xi=xi, p0_ini=p0_ini, p0_floor=p0_floor))
     model = mats[0].model
 
@@ -284,28 +168,26 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
         raise InvalidArgument("F_E0", f"array of shape {F0.shape}", f"finite, shape (3, 3) or ({n_pts}, 3, 3)")
     H0 = F0[:, :dim, :dim] - np.eye(dim)
     hzz0 = F0[:, 2, 2] - 1.0 if dim == 2 else np.zeros(n_pts)
-    if log_jp0 is None:
-        lj0 = np.array([getattr(mt, "initial_log_jp", 0.0) for mt in mats])
-    else:
-        lj0 = np.broadcast_to(np.asarray(log_jp0, dtype=np.float64), (n_pts,)).copy()
-        if not np.all(np.isfinite(lj0)):
-            raise InvalidArgument("log_jp0", log_jp0, "finite values")
+    lj0 = _per_point("log_jp0", log_jp0, [getattr(mt, "initial_log_jp", 0.0) for mt in mats])
+    kap0 = _per_point("kappa0", kappa0, [getattr(mt, "initial_kappa", 0.0) for mt in mats], lo=0.0)
 
-    control = np.zeros((n_pts, 2 * dim))
+    axes = np.zeros((n_pts, dim))
+    targets = np.full((n_pts, n_inc, dim), np.nan)
     if stress_control is not None:
         try:
-            axes = np.broadcast_to(np.asarray(stress_control["axes"], dtype=bool), (n_pts, dim))
-            target = np.broadcast_to(np.asarray(stress_control["sigma"], dtype=np.float64), (n_pts, dim))
+            axes[:] = np.broadcast_to(np.asarray(stress_control["axes"], dtype=bool), (n_pts, dim))
+            sig = np.asarray(stress_control["sigma"], dtype=np.float64)
+            sig = sig[:, None, :] if sig.ndim == 2 and sig.shape != (n_inc, dim) else sig
+            targets[:] = np.broadcast_to(sig, (n_pts, n_inc, dim))
         except (KeyError, TypeError, ValueError) as e:
-            expected = f"{{'axes': {dim} booleans, 'sigma': {dim} stresses (Pa)}} per point or shared"
+            expected = (f"{{'axes': {dim} booleans, 'sigma': {dim} stresses (Pa), or one row of them per increment "
+                        "(NaN: not controlled then)}, per point or shared")
             raise InvalidArgument("stress_control", stress_control, expected) from e
-        if not np.all(np.isfinite(target)):
-            raise InvalidArgument("stress_control.sigma", stress_control["sigma"], "finite stresses (Pa)")
-        control[:, :dim] = axes
-        control[:, dim:] = np.where(axes, target, 0.0)
+        if np.any(np.isinf(targets)):
+            raise InvalidArgument("stress_control.sigma", stress_control["sigma"], "finite stresses (Pa) or NaN")
     stiff = max(mt.lam + 2.0 * mt.mu for mt in mats)
     if stress_tol is None:
-        stress_tol = (2e-6 if dtype == "float32" else 1e-7) * stiff
+        stress_tol = (2.5e-7 if dtype == "float32" else 1e-12) * stiff
     if not (np.isfinite(stress_tol) and stress_tol > 0):
         raise InvalidArgument("stress_tol", stress_tol, "a finite number > 0 (Pa)")
 
@@ -314,23 +196,25 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
     shape = (n_pts, n_inc + 1)
     out = {
         "H": wp.zeros(shape, dtype=Md, device=device), "hzz": wp.zeros(shape, dtype=T, device=device),
-        "log_jp": wp.zeros(shape, dtype=T, device=device), "yielded": wp.zeros(shape, dtype=wp.int32, device=device),
+        "log_jp": wp.zeros(shape, dtype=T, device=device), "kappa": wp.zeros(shape, dtype=T, device=device),
+        "yielded": wp.zeros(shape, dtype=wp.int32, device=device),
         "eps_trial": wp.zeros(shape, dtype=V3, device=device), "eps": wp.zeros(shape, dtype=V3, device=device),
         "stress": wp.zeros(shape, dtype=M3, device=device), "p": wp.zeros(shape, dtype=T, device=device),
         "q": wp.zeros(shape, dtype=T, device=device), "p0": wp.zeros(shape, dtype=T, device=device),
-        "L": wp.zeros((n_pts, n_inc), dtype=Md, device=device),
+        "L": wp.zeros((n_pts, n_inc), dtype=Md, device=device), "F": wp.zeros(shape, dtype=Md, device=device),
         "control_residual": wp.zeros(shape, dtype=T, device=device),
     }
     params = wp.array([material_params(mt, T) for mt in mats], dtype=material_struct(T), device=device)
-    wp.launch(_drive_kernel(dim, T, model), dim=n_pts,
-              inputs=[wp.array(L.astype(np_t), dtype=Md, device=device), params,
+    wp.launch(drive_kernel(dim, T, model), dim=n_pts,
+              inputs=[wp.array(L.astype(np_t), dtype=Md, device=device), int(name == "F_total"), params,
                       wp.array(H0.astype(np_t), dtype=Md, device=device),
                       wp.array(hzz0.astype(np_t), dtype=T, device=device),
                       wp.array(lj0.astype(np_t), dtype=T, device=device),
-                      wp.array(control.astype(np_t), dtype=T, device=device),
-                      wp.array([stress_tol], dtype=T, device=device)],
-              outputs=[out[k] for k in ("H", "hzz", "log_jp", "yielded", "eps_trial", "eps", "stress", "p", "q",
-                                        "p0", "L", "control_residual")],
+                      wp.array(kap0.astype(np_t), dtype=T, device=device),
+                      wp.array(axes.astype(np_t), dtype=T, device=device),
+                      wp.array(targets.astype(np_t), dtype=T, device=device), T(stress_tol)],
+              outputs=[out[k] for k in ("H", "hzz", "log_jp", "kappa", "yielded", "eps_trial", "eps", "stress", "p",
+                                        "q", "p0", "L", "F", "control_residual")],
               device=device)
     res = {k: a.numpy() for k, a in out.items()}
     if dim == 3:
@@ -342,8 +226,22 @@ def drive_material_points(F_path=None, *, L_path=None, material=None, F_E0=None,
     if dim == 2:
         F[..., 2, 2] += hzz
     res["F_E"] = F
-    if model == "elastic":
+    Ft = np.zeros((n_pts, n_inc + 1, 3, 3))
+    Ft[..., :dim, :dim] = res["F"]
+    if dim == 2:
+        Ft[..., 2, 2] = 1.0
+    res["F"] = Ft
+    J = np.exp(res["eps"].astype(np.float64).sum(axis=-1))
+    if model != "elastic":
+        J = J * np.exp(res["log_jp"].astype(np.float64) - np.array([m.initial_log_jp for m in mats])[:, None])
+    else:
         res.pop("p0")
+    res["tau"] = res["stress"].astype(np.float64) * J[..., None, None]
+    if model == "bonded_camclay":
+        ks = np.array([m.kappa_s for m in mats])[:, None]
+        res["bond"] = np.maximum(0.0, 1.0 - res["kappa"].astype(np.float64) / ks)
+    else:
+        res.pop("kappa")
     return res
 
 

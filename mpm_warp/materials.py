@@ -191,7 +191,7 @@ class BondedCamClay(Elastic):
     p_bond : float
         Bonded part of the consolidation pressure of the intact layer (Pa), >= 0.
     kappa_s : float
-        Accumulated plastic strain at which the bond is gone (-), > 0.
+        Accumulated plastic strain at which the bond is gone (-), > 0; ``inf`` keeps the bond.
     """
 
     M: float = 1.2
@@ -213,7 +213,8 @@ class BondedCamClay(Elastic):
         finite_number(f"{where}.p0_int_ini", self.p0_int_ini, lo=0.0)
         finite_number(f"{where}.p0_floor_ratio", self.p0_floor_ratio, lo=0.0, hi=1e-2, lo_open=True)
         finite_number(f"{where}.p_bond", self.p_bond, lo=0.0)
-        finite_number(f"{where}.kappa_s", self.kappa_s, lo=0.0, lo_open=True)
+        if self.kappa_s != math.inf:  # inf: a bond that never breaks (structured Cam-Clay without destructuring)
+            finite_number(f"{where}.kappa_s", self.kappa_s, lo=0.0, lo_open=True)
         return self
 
     @property

@@ -3,10 +3,12 @@
 Per particle on the device, with ``s`` = 4 bytes (float32) or 8 (float64) and ``d`` the dimension:
 ``x``, ``v`` (``d s`` each), ``C``, ``H = F_E - I`` (``d^2 s`` each), in plane strain ``hzz`` (``s``),
 for plastic (Cam-Clay) particles ``log_jp`` (``s``), for bonded ones ``kappa`` (``s``) and, when the
-output asks for it, ``yielded`` (1 byte). The grid is ``n_copies x nodes x (1 + d)`` scalars (mass
-and momentum; one copy per CPU thread, :func:`mpm_warp.step.grid_copies`). The host keeps the seeded
-positions and the initial positions ``x0`` in float64 (``2 d 8`` bytes per particle) and builds the
-initial ``x``, ``v``, ``C`` before uploading them. Frames and checkpoints add host copies of the
+output asks for it, ``yielded`` (1 byte). A bonded weak layer also has its lattice columns: a column
+index per particle (int32, on the device and on the host) and a float64 pair per column. The grid
+is ``n_copies x nodes x (1 + d)`` scalars (mass and momentum; one copy per CPU thread,
+:func:`mpm_warp.step.grid_copies`). The host keeps the seeded positions and the initial positions
+``x0`` in float64 (``2 d 8`` bytes per particle) and builds the initial ``x``, ``v``, ``C`` before
+uploading them. Frames and checkpoints add host copies of the
 fields they write (not counted). ``tests/test_memory.py`` checks these numbers against what
 :class:`~mpm_warp.model.State`, :class:`~mpm_warp.step.Stepper` and :class:`~mpm_warp.Simulation`
 really allocate.
@@ -19,6 +21,7 @@ the key to change.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -26,7 +29,7 @@ import warp as wp
 
 from .config import Scenario
 from .errors import InvalidArgument
-from .model import grid_shape, lattice_shape
+from .model import grid_shape, lattice_counts
 from .step import grid_copies
 
 __all__ = ["MemoryEstimate", "estimate_memory", "available_memory", "check_memory", "parse_bytes",
@@ -78,17 +81,21 @@ class MemoryEstimate:
     n_particles : int
     particles : int
         Device bytes of the particle state.
+    columns : int
+        Device bytes of the bonded weak layers' lattice columns (index per particle, sums per column).
     grid_nodes, grid_copies : int
     grid : int
         Device bytes of the grid copies.
     host : int
-        Host bytes kept beside the state for the whole run: the seeded and the initial positions.
+        Host bytes kept beside the state for the whole run: the seeded and the initial positions,
+        the bonded layers' column indices.
     staging : int
         Host bytes of the initial ``x``, ``v``, ``C`` built before their upload (freed after).
     """
 
     n_particles: int
     particles: int
+    columns: int
     grid_nodes: int
     grid_copies: int
     grid: int
@@ -97,13 +104,13 @@ class MemoryEstimate:
 
     @property
     def device(self) -> int:
-        """Device bytes: particles and grid."""
-        return self.particles + self.grid
+        """Device bytes: particles, bonded columns and grid."""
+        return self.particles + self.columns + self.grid
 
     @property
     def total(self) -> int:
         """Everything: device, host and staging bytes (all host memory on the CPU)."""
-        return self.particles + self.grid + self.host + self.staging
+        return self.device + self.host + self.staging
 
 
 def estimate_memory(scenario: Scenario, device: str, n_threads: int | None = None) -> MemoryEstimate:
@@ -111,22 +118,24 @@ def estimate_memory(scenario: Scenario, device: str, n_threads: int | None = Non
     dom, dim, prec = scenario.domain, scenario.domain.dimension, scenario.precision
     s = 8 if prec == "float64" else 4
     yielded = "yielded" in scenario.output.fields
-    n, part = 0, 0
+    n, part, bonded_n, columns = 0, 0, 0, 0
     for b in scenario.blocks:
-        count = 1
-        for c in lattice_shape(b.lo, b.hi, dom.dx, b.particles_per_cell):
-            count *= c
+        counts = lattice_counts(b.lo, b.hi, dom.dx, b.particles_per_cell)
+        count = math.prod(counts)
         mat = scenario.materials[b.material]
+        bonded = mat.model == "bonded_camclay"
         n += count
-        part += count * particle_bytes(dim, prec, plastic=mat.plastic, bonded=hasattr(mat, "initial_kappa"),
-                                       yielded=yielded)
+        part += count * particle_bytes(dim, prec, plastic=mat.plastic, bonded=bonded, yielded=yielded)
+        if bonded:                 # column index (int32) per particle, a vec2d of sums per column (all but y)
+            bonded_n += count
+            columns += count * 4 + (count // counts[1]) * 16
     shape = grid_shape(dom.lo, dom.hi, dom.dx)
     nodes = 1
     for c in shape:
         nodes *= c
     copies = grid_copies(device, n, shape, n_threads)
-    return MemoryEstimate(n, part, nodes, copies, copies * nodes * (1 + dim) * s, n * 2 * dim * 8,
-                          n * (2 * dim + dim * dim) * s)
+    return MemoryEstimate(n, part, columns, nodes, copies, copies * nodes * (1 + dim) * s,
+                          n * 2 * dim * 8 + bonded_n * 4, n * (2 * dim + dim * dim) * s)
 
 
 def available_memory(device: str) -> tuple[int | None, int | None]:

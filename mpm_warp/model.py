@@ -21,10 +21,10 @@ from .kernels.camclay import SINGULAR_VALUE_FLOOR
 from .kernels.constitutive import material_struct
 from .kernels.grid_update import wall_struct
 from .kernels.types import mat, vec
-from .materials import CamClaySnow, Elastic
+from .materials import BondedCamClay, CamClaySnow, Elastic
 
-__all__ = ["Model", "State", "ParticleGroup", "seed_block", "lattice_shape", "grid_shape", "velocity_gradient",
-           "material_params", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
+__all__ = ["Model", "State", "ParticleGroup", "seed_block", "lattice_counts", "lattice_columns", "grid_shape",
+           "velocity_gradient", "material_params", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
 
 #: grid nodes added outside the domain box on each side
 GRID_PADDING = 3
@@ -35,7 +35,10 @@ class ParticleGroup:
     """A contiguous range of particles of one material and one particle volume.
 
     ``start:end`` indexes the particle arrays; ``plastic_start`` indexes
-    ``log_jp`` (Cam-Clay groups only, else -1).
+    ``log_jp`` (Cam-Clay groups only, else -1) and, for a bonded weak layer
+    (whose groups come first among the plastic ones), ``kappa`` too;
+    ``columns`` (bonded groups) the lattice column of each particle
+    (:func:`lattice_columns`) and ``n_columns`` their count.
     """
 
     name: str
@@ -46,17 +49,13 @@ class ParticleGroup:
     vol0: float
     mass: float
     plastic_start: int = -1
+    columns: np.ndarray | None = None
+    n_columns: int = 0
 
     @property
     def count(self) -> int:
         """Number of particles in the group."""
         return self.end - self.start
-
-
-def lattice_shape(lo, hi, dx: float, ppc: int) -> tuple[int, ...]:
-    """Particles per axis that :func:`seed_block` puts in ``[lo, hi]`` (spacing ``dx / ppc``, at least one)."""
-    h = dx / ppc
-    return tuple(max(1, int(round((hi[a] - lo[a]) / h))) for a in range(len(lo)))
 
 
 def grid_shape(lo, hi, dx: float) -> tuple[int, ...]:
@@ -75,12 +74,18 @@ def seed_block(lo, hi, dx: float, ppc: int) -> tuple[np.ndarray, float]:
     """
     dim = len(lo)
     axes = []
-    for a, n in enumerate(lattice_shape(lo, hi, dx, ppc)):
+    for a, n in enumerate(lattice_counts(lo, hi, dx, ppc)):
         step = (hi[a] - lo[a]) / n
         axes.append(lo[a] + (np.arange(n) + 0.5) * step)
     vol = float(np.prod([(hi[a] - lo[a]) / len(axes[a]) for a in range(dim)]))
     grids = np.meshgrid(*axes, indexing="ij")
     return np.stack([g.ravel() for g in grids], axis=1), vol
+
+
+def lattice_counts(lo, hi, dx: float, ppc: int) -> tuple[int, ...]:
+    """Particles per axis of the :func:`seed_block` lattice of ``[lo, hi]``."""
+    h = dx / ppc
+    return tuple(max(1, int(round((hi[a] - lo[a]) / h))) for a in range(len(lo)))
 
 
 def material_params(material: Elastic, T):
@@ -89,9 +94,25 @@ def material_params(material: Elastic, T):
     m.mu = T(material.mu)
     m.lam = T(material.lam)
     m.s_floor = T(SINGULAR_VALUE_FLOOR)
-    if isinstance(material, CamClaySnow):
+    if isinstance(material, (CamClaySnow, BondedCamClay)):
         m.M, m.beta, m.xi, m.p0_floor = T(material.M), T(material.beta), T(material.xi), T(material.p0_floor)
+        m.log_jp_ref = T(material.initial_log_jp)
+    if isinstance(material, BondedCamClay):
+        m.p_bond, m.kappa_s = T(material.p_bond), T(material.kappa_s)
     return m
+
+
+def lattice_columns(counts) -> np.ndarray:
+    """Column index (int32) of every particle of a :func:`seed_block` lattice with ``counts`` per axis.
+
+    A column is the particles seeded at one bed position (same lattice index on every axis
+    but ``y``, axis 1, the bed normal): the bonded weak layer averages its plastic strain
+    over them after every step (``kernels/bonded_camclay.py``: the softening lives on the
+    layer's total slip, so its energy per unit area does not depend on dx).
+    """
+    idx = np.indices(counts).reshape(len(counts), -1)
+    col = idx[0] * (counts[2] if len(counts) == 3 else 1) + (idx[2] if len(counts) == 3 else 0)
+    return col.astype(np.int32)
 
 
 def velocity_gradient(field, x: np.ndarray, h: float) -> np.ndarray:
@@ -163,18 +184,25 @@ class Model:
         self.c_p = max(m.p_wave_speed for m in scenario.materials.values())
         self.gravity = np.asarray(scenario.time.gravity, dtype=np.float64)
 
-        # particle groups: plastic groups first, so log_jp is one contiguous prefix
-        blocks = sorted(scenario.blocks, key=lambda b: not scenario.materials[b.material].plastic)
+        # particle groups: bonded weak layers, then the other plastic groups, then elastic ones, so that kappa and
+        # log_jp are contiguous prefixes
+        blocks = sorted(scenario.blocks, key=lambda b: (not scenario.materials[b.material].plastic,
+                                                        scenario.materials[b.material].model != "bonded_camclay"))
         self.groups: list[ParticleGroup] = []
         self._seed = []
         start = 0
         pstart = 0
+        self.n_bonded = 0
         for b in blocks:
             mat = scenario.materials[b.material]
             x, vol = seed_block(b.lo, b.hi, self.dx, b.particles_per_cell)
             n = len(x)
             g = ParticleGroup(b.name, b.material, mat, start, start + n, vol, mat.density * vol,
                               pstart if mat.plastic else -1)
+            if mat.model == "bonded_camclay":
+                g.columns = lattice_columns(lattice_counts(b.lo, b.hi, self.dx, b.particles_per_cell))
+                g.n_columns = int(g.columns.max()) + 1
+                self.n_bonded += n
             if mat.plastic:
                 pstart += n
             start += n
@@ -222,11 +250,13 @@ class Model:
             else:
                 v[g.start:g.end] = np.broadcast_to(np.asarray(b.velocity), xb.shape)
         ljp = np.zeros(self.n_plastic, dtype=self.np_dtype)
+        kappa = np.zeros(self.n_bonded, dtype=self.np_dtype)
         for g in self.groups:
             if g.material.plastic:
-                assert isinstance(g.material, CamClaySnow)
                 ljp[g.plastic_start:g.plastic_start + g.count] = g.material.initial_log_jp
-        return State(self, x, v, C, ljp, track_yield)
+            if g.columns is not None:
+                kappa[g.plastic_start:g.plastic_start + g.count] = g.material.initial_kappa
+        return State(self, x, v, C, ljp, kappa, track_yield)
 
     def bytes_per_particle(self, state: State) -> float:
         """Device bytes of particle fields per particle (grid excluded)."""
@@ -250,6 +280,8 @@ class State:
         Out-of-plane elastic stretch minus one, ``F_E,zz - 1`` (-), plane strain only.
     log_jp : wp.array, (N_plastic,) or None
         ln det F_P of Cam-Clay particles.
+    kappa : wp.array, (N_bonded,) or None
+        Accumulated plastic strain of bonded weak-layer particles (-), the first plastic ones.
     yielded : wp.array of uint8, (N_plastic,) or None
         Return-mapping activity flag, only when the output asks for it.
     clock : wp.array of float64, (4,)
@@ -259,9 +291,9 @@ class State:
     """
 
     #: the arrays a checkpoint holds (those that exist; ``yielded`` holds the flags of a frame stopped half-way)
-    CHECKPOINT_FIELDS = ("x", "v", "C", "H", "hzz", "log_jp", "yielded", "clock", "steps")
+    CHECKPOINT_FIELDS = ("x", "v", "C", "H", "hzz", "log_jp", "kappa", "yielded", "clock", "steps")
 
-    def __init__(self, model: Model, x, v, C, log_jp, track_yield: bool):
+    def __init__(self, model: Model, x, v, C, log_jp, kappa, track_yield: bool):
         dev = model.device
         T = model.T
         d = model.dim
@@ -274,6 +306,7 @@ class State:
         self.H = wp.zeros(n, dtype=M, device=dev)
         self.hzz = wp.zeros(n, dtype=T, device=dev) if d == 2 else None
         self.log_jp = wp.array(log_jp, dtype=T, device=dev) if model.n_plastic else None
+        self.kappa = wp.array(kappa, dtype=T, device=dev) if model.n_bonded else None
         track = track_yield and model.n_plastic > 0
         self.yielded = wp.zeros(model.n_plastic, dtype=wp.uint8, device=dev) if track else None
         self.clock = wp.zeros(4, dtype=wp.float64, device=dev)
@@ -281,7 +314,7 @@ class State:
 
     def particle_bytes(self) -> int:
         """Bytes held by per-particle arrays on the device."""
-        arrs = [self.x, self.v, self.C, self.H, self.hzz, self.log_jp, self.yielded]
+        arrs = [self.x, self.v, self.C, self.H, self.hzz, self.log_jp, self.kappa, self.yielded]
         return sum(a.capacity for a in arrs if a is not None)
 
     def elastic_deformation_gradient(self) -> np.ndarray:

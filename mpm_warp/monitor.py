@@ -79,6 +79,8 @@ class GroupState:
         ``F_E,zz - 1`` (-) in plane strain (2D), else None.
     log_jp : wp.array or None
         ``ln det F_P`` of a Cam-Clay group (None for elastic groups).
+    kappa : wp.array or None
+        Accumulated plastic strain of a bonded weak-layer group (-), else None.
     x0 : ndarray (n, 3), float64
         Initial positions (m), host copy.
     """
@@ -96,6 +98,7 @@ class GroupState:
     hzz: wp.array | None
     log_jp: wp.array | None
     x0: np.ndarray
+    kappa: wp.array | None = None
 
     @property
     def count(self) -> int:

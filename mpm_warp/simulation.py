@@ -75,6 +75,7 @@ class Simulation:
         self._since_health = 0
         self._bad = wp.full(3, INT_MAX, dtype=wp.int32, device=self.device)
         self._energy = wp.zeros(2, dtype=wp.float64, device=self.device)
+        self._no_log_jp = wp.zeros(0, dtype=self.model.T, device=self.device)  # elastic groups: no plastic volume
         self._stop_now = False
 
     # ----------------------------------------------------------------- public
@@ -109,9 +110,10 @@ class Simulation:
         """Array views of the state of group ``name`` (:class:`mpm_warp.monitor.GroupState`)."""
         g, s = self.group(name), self.state
         sl = slice(g.start, g.end)
-        ljp = s.log_jp[g.plastic_start:g.plastic_start + g.count] if g.plastic_start >= 0 else None
+        psl = slice(g.plastic_start, g.plastic_start + g.count)
         return GroupState(g.name, g.material, g.start, g.end, g.mass, g.vol0, s.x[sl], s.v[sl], s.C[sl], s.H[sl],
-                          s.hzz[sl] if s.hzz is not None else None, ljp, self.x0[sl])
+                          s.hzz[sl] if s.hzz is not None else None, s.log_jp[psl] if g.plastic_start >= 0 else None,
+                          self.x0[sl], s.kappa[psl] if g.columns is not None else None)
 
     def energies(self) -> dict[str, float]:
         """Kinetic and elastic energy (J; J/m of depth in 2D) of the current state."""
@@ -140,8 +142,9 @@ class Simulation:
         for g in self.model.groups:
             sl = slice(g.start, g.end)
             hz = s.hzz[sl] if s.hzz is not None else None
+            ljp = s.log_jp[g.plastic_start:g.plastic_start + g.count] if g.plastic_start >= 0 else self._no_log_jp
             wp.launch(stress_kernel(self.model.dim, T), g.count,
-                      inputs=[s.H[sl], hz, material_params(g.material, T), int(cauchy), p[sl], q[sl],
+                      inputs=[s.H[sl], hz, ljp, material_params(g.material, T), int(cauchy), p[sl], q[sl],
                               sig[sl] if cauchy else None],
                       device=self.device)
         return p.numpy(), q.numpy(), sig.numpy() if cauchy else None
@@ -161,13 +164,14 @@ class Simulation:
             return s.elastic_deformation_gradient().astype(self.model.np_dtype)
         if name == "stress":
             return self.stresses(cauchy=True)[2]
-        if name == "log_jp":
+        if name in ("log_jp", "kappa"):
             out = np.zeros(n, dtype=self.model.np_dtype)
-            if s.log_jp is not None:
-                lj = s.log_jp.numpy()
+            arr = getattr(s, name)
+            if arr is not None:
+                a = arr.numpy()
                 for g in self.model.groups:
-                    if g.plastic_start >= 0:
-                        out[g.start:g.end] = lj[g.plastic_start:g.plastic_start + g.count]
+                    if g.plastic_start >= 0 and (name == "log_jp" or g.columns is not None):
+                        out[g.start:g.end] = a[g.plastic_start:g.plastic_start + g.count]
             return out
         if name in ("p", "q"):
             p, q = self.stress_invariants()

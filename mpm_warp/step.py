@@ -15,6 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import warp as wp
 
+from .kernels.bonded_camclay import column_sums_zero_kernel, kappa_column_mean_kernel, kappa_column_sum_kernel
 from .kernels.g2p import g2p_kernel
 from .kernels.grid_update import grid_update_kernel
 from .kernels.p2g import p2g_kernel
@@ -114,16 +115,16 @@ class Stepper:
                 if b <= a:
                     continue
                 sl = slice(a, b)
+                ljp, kap, yld = None, None, None
                 if plastic:
                     psl = slice(g.plastic_start + a - g.start, g.plastic_start + b - g.start)
                     ljp = s.log_jp[psl]
+                    kap = s.kappa[psl] if g.columns is not None else None
                     yld = s.yielded[psl] if s.yielded is not None else None
-                else:
-                    ljp, yld = None, None
                 hz = s.hzz[sl] if s.hzz is not None else None
                 self._p2g[k].append(wp.launch(
                     k_p2g, b - a,
-                    inputs=[s.x[sl], s.v[sl], s.C[sl], s.H[sl], hz, ljp, yld, T(g.mass), T(g.vol0), m_par,
+                    inputs=[s.x[sl], s.v[sl], s.C[sl], s.H[sl], hz, ljp, kap, yld, T(g.mass), T(g.vol0), m_par,
                             self.dt, origin, inv_dx, dx, shape, self.grid_m_all[k], self.grid_p_all[k],
                             self.counts[k]],
                     device=dev, record_cmd=True))
@@ -144,6 +145,20 @@ class Stepper:
                 inputs=[s.x[sl], s.v[sl], s.C[sl], self.grid_p, self.dt, origin, inv_dx, dx, shape, V(*model.x_lo),
                         V(*model.x_hi), self.counts[k]],
                 device=dev, record_cmd=True))
+        # bonded weak layers: kappa replaced by its lattice-column mean after every step (kernels/bonded_camclay.py)
+        self._columns = []
+        self.column_sums = []
+        for g in model.groups:
+            if g.columns is None:
+                continue
+            kap = s.kappa[g.plastic_start:g.plastic_start + g.count]
+            col = wp.array(g.columns, dtype=wp.int32, device=dev)
+            sums = wp.zeros(g.n_columns, dtype=wp.vec2d, device=dev)
+            self.column_sums.append((col, sums))
+            self._columns += [
+                wp.launch(column_sums_zero_kernel(), g.n_columns, inputs=[sums], device=dev, record_cmd=True),
+                wp.launch(kappa_column_sum_kernel(T), g.count, inputs=[kap, col, sums], device=dev, record_cmd=True),
+                wp.launch(kappa_column_mean_kernel(T), g.count, inputs=[sums, col, kap], device=dev, record_cmd=True)]
         self._end = wp.launch(end_step_kernel(), 1, inputs=[s.clock, s.steps], device=dev, record_cmd=True)
         self.use_graph = wp.get_device(dev).is_cuda if use_graph is None else use_graph
         self._graph = None
@@ -157,8 +172,8 @@ class Stepper:
     @property
     def launches(self) -> list:
         """Every recorded launch of the plan (for compiling ahead of timing)."""
-        return [self._begin, *[k for ks in self._p2g for k in ks], *self._grid, *self._g2p, self._end,
-                *self.actions]
+        return [self._begin, *[k for ks in self._p2g for k in ks], *self._grid, *self._g2p, *self._columns,
+                self._end, *self.actions]
 
     # ------------------------------------------------------------------ steps
     def _scatter(self, k: int) -> None:
@@ -180,6 +195,8 @@ class Stepper:
             list(self._pool.map(self._scatter, range(n)))
             list(self._pool.map(lambda k: self._grid[k].launch(), range(n)))
             list(self._pool.map(lambda k: self._g2p[k].launch(), range(n)))
+        for launch in self._columns:
+            launch.launch()
         self._end.launch()
 
     def steps(self, n: int) -> None:

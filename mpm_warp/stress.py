@@ -5,7 +5,7 @@ The device computes the same stress in :func:`mpm_warp.kernels.elasticity.hencky
 one host-side copy, in float64, for analyses, validation and tests:
 
     F_E = U diag(s) V^T,  eps_i = ln max(s_i, s_floor),  tau_i = 2 mu eps_i + lam tr(eps)
-    tau = U diag(tau_i) U^T (Kirchhoff, Pa),  sigma = tau / J,  J = prod_i max(s_i, s_floor)
+    tau = U diag(tau_i) U^T (Kirchhoff, Pa),  sigma = tau / (J_E J_P),  J_E = prod_i max(s_i, s_floor)
 
 Singular values follow ``wp.svd3``: the last one carries the sign of ``det F_E``, so an inverted
 ``F_E`` has its smallest singular value floored at ``s_floor`` exactly as on the device. Stresses
@@ -44,9 +44,14 @@ def kirchhoff_stress(F, mu: float, lam: float, s_floor: float = SINGULAR_VALUE_F
     return np.einsum("nij,nj,nkj->nik", U, tau_p, U)
 
 
-def cauchy_stress(F, mu: float, lam: float, s_floor: float = SINGULAR_VALUE_FLOOR) -> np.ndarray:
-    """Cauchy stress ``sigma = tau / J`` (Pa, tension positive), shape (n, 3, 3), float64."""
+def cauchy_stress(F, mu: float, lam: float, s_floor: float = SINGULAR_VALUE_FLOOR, plastic_volume=1.0) -> np.ndarray:
+    """Cauchy stress ``sigma = tau / (J_E J_P)`` (Pa, tension positive), shape (n, 3, 3), float64.
+
+    ``plastic_volume`` is the plastic change of volume since the material was placed,
+    ``J_P = exp(log_jp - log_jp_ref)`` (a float or one per stress; 1 for elastic materials).
+    """
     U, eps, J = principal_strains(F, s_floor)
+    J = J * np.broadcast_to(np.asarray(plastic_volume, dtype=np.float64), J.shape)
     tau_p = 2.0 * mu * eps + lam * eps.sum(axis=1, keepdims=True)
     return np.einsum("nij,nj,nkj->nik", U, tau_p / J[:, None], U)
 

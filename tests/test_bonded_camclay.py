@@ -24,7 +24,6 @@ import numpy as np
 import pytest
 import warp as wp
 
-from mpm_warp.bonded_point import drive_bonded, total_path
 from mpm_warp.errors import InvalidArgument
 from mpm_warp.kernels.bonded_camclay import (
     bonded_camclay_return_func,
@@ -39,6 +38,7 @@ from mpm_warp.material_point import drive_material_points, lame_parameters, stra
 from mpm_warp.materials import BondedCamClay
 from mpm_warp.model import seed_block
 from mpm_warp.scenes.weak_layer.calibration import layer_columns
+from mpm_warp.scenes.weak_layer.paths import drive_layer, simple_shear_path
 
 DEVICE = "cpu"
 TYPES = {"float32": (wp.float32, np.float32, 2.0**-24), "float64": (wp.float64, np.float64, 2.0**-53)}
@@ -359,8 +359,8 @@ def test_objectivity_through_driver(dtype, tol):
         F[:, k] = acc
     R = _random_rotation(rng)
     mat = BondedCamClay(1e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.05, p_bond=2e3, kappa_s=0.01)
-    a = drive_bonded(mat, F, dtype=dtype)
-    b = drive_bonded(mat, np.einsum("ij,pkjl->pkil", R, F), dtype=dtype)
+    a = drive_layer(mat, F, dtype=dtype)
+    b = drive_layer(mat, np.einsum("ij,pkjl->pkil", R, F), dtype=dtype)
     assert 0.2 < a["yielded"][:, 1:].mean() < 1.0 and a["bond"][:, -1].min() < 0.9
     scale = np.abs(a["p"]).max()
     for k in ("p", "q"):
@@ -423,13 +423,13 @@ def test_no_cycling_converges_to_the_critical_state(dtype, dgamma):
     0.005 here): measured 524.9, 526.4, 539.8 Pa at 0.02, 0.01, 0.005. Bound 5 %.
     """
     n = int(round(0.4 / dgamma))
-    F = total_path(np.linspace(dgamma, 0.4, n))
+    F = simple_shear_path(np.linspace(dgamma, 0.4, n))
     E, nu, M, beta, xi, p0i = (CYCLE[k] for k in ("E", "nu", "M", "beta", "xi", "p0_ini"))
     rel, step = (1e-8, 1e-9) if dtype == "float64" else (5e-2, 1e-2)
     kept = BondedCamClay(E, nu, 150.0, M=M, beta=beta, xi=xi, p0_int_ini=p0i, p_bond=0.0, kappa_s=math.inf)
     lost = BondedCamClay(E, nu, 150.0, M=M, beta=beta, xi=xi, p0_int_ini=p0i, p_bond=1000.0, kappa_s=0.05)
     for mat, beta_end in ((kept, beta), (lost, 0.0)):
-        r = drive_bonded(mat, F, dtype=dtype)
+        r = drive_layer(mat, F, dtype=dtype)
         p_cs = _isochoric_critical_state(E, nu, beta_end, xi, p0i)
         tail = r["p"][0, -10:]
         print(f"{dtype} dgamma={dgamma} beta_end={beta_end}: p tail {tail[-2:]} against {p_cs:.3f} Pa")

@@ -141,3 +141,61 @@ def test_driver_takes_initial_states_and_reports_trial_strains():
     assert r["log_jp"][0, 0] == -0.2
     np.testing.assert_allclose(np.sort(r["eps_trial"][0, 1]), np.sort(np.log([1.001 * 1.001, 0.998, 1.0])),
                                rtol=0, atol=1e-13)
+
+
+WL = mw.BondedCamClay(1.0e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.01, p_bond=1500.0, kappa_s=0.02)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("precision", ["float32", "float64"])
+def test_driver_is_the_engine_update_for_the_bonded_layer(dim, precision):
+    """Bonded weak layer: with one particle per lattice column (a layer one particle thick) the column mean of
+    kappa leaves it as the update made it, and the driver follows the particles bit for bit, kappa included."""
+    dt = 2e-5
+    A = np.array([[-2.0, 8.0, 0.0], [0.0, -6.0, 0.0], [0.0, 0.0, -1.0]])[:dim, :dim]
+    sc = mw.Scenario(
+        name="layer", domain=mw.Domain((0.0,) * dim, (1.0,) * dim, 0.1, boundary="none", dimension=dim),
+        time=mw.TimeControl(end=1.0, frame_interval=1.0, dt=dt, gravity=(0.0,) * dim),
+        materials={"wl": WL}, precision=precision,
+        blocks=(mw.Block("wl", (0.3, 0.45, 0.3)[:dim], (0.7, 0.5, 0.7)[:dim], particles_per_cell=2,
+                         velocity=lambda x: (x - 0.5) @ A.T),))
+    sim = mw.Simulation(sc, device=DEVICE)
+    assert sim.model.groups[0].n_columns == sim.model.n_particles    # one particle across the layer
+    sim.stepper.set_frame_end(1.0)
+    n, picks = 600, [0, 3, sim.model.n_particles - 1]
+    np_t = sim.model.np_dtype
+    L = np.zeros((len(picks), n, dim, dim), dtype=np_t)
+    H = np.zeros((len(picks), n + 1, dim, dim), dtype=np_t)
+    kap = np.zeros((len(picks), n + 1), dtype=np_t)
+    for k in range(n):
+        L[:, k] = np_t(dt) * sim.state.C.numpy()[picks]
+        sim.stepper.steps(1)
+        H[:, k + 1] = sim.state.H.numpy()[picks]
+        kap[:, k + 1] = sim.state.kappa.numpy()[picks]
+    r = drive_material_points(L_path=L, material=WL, dtype=precision, device=DEVICE)
+    np.testing.assert_array_equal(r["H"][:, 1:], H[:, 1:])
+    np.testing.assert_array_equal(r["kappa"][:, 1:], kap[:, 1:])
+    assert kap[:, -1].min() > 0.2 * WL.kappa_s and r["yielded"].sum() > 50   # the bond really softened
+
+
+def test_kappa_is_the_column_mean_across_the_layer():
+    """A bonded layer four cells thick sheared in the engine: after every step each lattice column (one bed
+    position across the layer) carries one kappa, the mean of what its particles' returns added."""
+    dim = 2
+    def shear(x):                                                    # simple shear with a little compaction
+        return np.stack([50.0 * (x[:, 1] - 0.4), -2.0 * (x[:, 1] - 0.4)], axis=1)
+
+    sc = mw.Scenario(
+        name="layer", domain=mw.Domain((0.0, 0.0), (1.0, 1.0), 0.02, boundary="none", dimension=dim),
+        time=mw.TimeControl(end=1.0, frame_interval=1.0, dt=1e-5, gravity=(0.0, 0.0)),
+        materials={"wl": WL}, precision="float64",
+        blocks=(mw.Block("wl", (0.3, 0.4), (0.7, 0.48), velocity=shear),))
+    sim = mw.Simulation(sc, device=DEVICE)
+    g = sim.model.groups[0]
+    assert g.n_columns == 40 and g.count == 40 * 8                   # 0.4 m / 1 cm lattice, 8 particles across
+    sim.stepper.set_frame_end(1.0)
+    sim.stepper.steps(200)
+    kappa = sim.state.kappa.numpy()
+    per_column = [kappa[g.columns == c] for c in range(g.n_columns)]
+    assert max(np.ptp(k) for k in per_column) == 0.0
+    assert np.mean([k[0] > 0.0 for k in per_column]) > 0.9           # the layer yielded (not at its free ends)

@@ -27,19 +27,34 @@ def _plane_block(precision: str) -> mw.Scenario:
                        precision=precision)
 
 
+def _bonded_layer(dim: int, precision: str) -> mw.Scenario:
+    """A slab on a bonded weak layer (kappa and lattice columns) on Cam-Clay, with yield flags in the output."""
+    lo, hi = (0.0, 0.0, 0.0)[:dim], (0.6, 0.3, 0.1)[:dim]
+    box = lambda y0, y1: ((0.1, y0, 0.0)[:dim], (0.5, y1, 0.1)[:dim])        # noqa: E731
+    return mw.Scenario(name="bonded", domain=mw.Domain(lo, hi, 0.02, dimension=dim),
+                       time=mw.TimeControl(end=0.01, frame_interval=0.01),
+                       materials={"slab": mw.Elastic(1e6, 0.3, 250.0), "base": mw.CamClaySnow(1e6, 0.3, 200.0),
+                                  "weak": mw.BondedCamClay(1e6, 0.3, 150.0, p_bond=1e3)},
+                       blocks=(mw.Block("slab", *box(0.14, 0.24)), mw.Block("weak", *box(0.1, 0.14), name="weak"),
+                               mw.Block("base", *box(0.02, 0.1))),
+                       output=mw.Output(fields=("x", "yielded")), precision=precision)
+
+
 SCENES = {
     "block-float32": lambda: (mw.load_scenario("elastic_block"), 1),
     "block-float64-2-threads": lambda: (mw.load_scenario("elastic_block", ['precision="float64"']), 2),
     "plane-strain-float32": lambda: (_plane_block("float32"), 1),
     "plane-strain-float64-camclay": lambda: (_plane_block("float64"), 2),
     "pst-camclay-yielded": lambda: (mw.load_scenario("pst_demo", TINY_PST), 1),
+    "bonded-3d-float32-2-threads": lambda: (_bonded_layer(3, "float32"), 2),
+    "bonded-2d-float64": lambda: (_bonded_layer(2, "float64"), 1),
 }
 
 
-def _particle_arrays(state, n: int, n_plastic: int) -> int:
+def _particle_arrays(state, *counts: int) -> int:
     """Bytes of every per-particle Warp array the state holds (a new field counts here without being listed)."""
     return sum(a.capacity for k, a in vars(state).items()
-               if isinstance(a, wp.array) and k not in ("clock", "steps") and a.shape[0] in (n, n_plastic))
+               if isinstance(a, wp.array) and k not in ("clock", "steps") and a.shape[0] in counts)
 
 
 @pytest.mark.parametrize("name", list(SCENES))
@@ -49,14 +64,18 @@ def test_estimate_equals_the_allocation(name):
     est = estimate_memory(sim.scenario, "cpu", threads)
     m, st = sim.model, sim.stepper
     assert est.n_particles == m.n_particles
-    assert est.particles == _particle_arrays(sim.state, m.n_particles, m.n_plastic) == sim.state.particle_bytes()
+    assert est.particles == _particle_arrays(sim.state, m.n_particles, m.n_plastic, m.n_bonded) == \
+        sim.state.particle_bytes()
+    assert est.columns == sum(col.capacity + sums.capacity for col, sums in st.column_sums)
+    assert (est.columns > 0) == name.startswith("bonded")
     assert est.grid_copies == st.n_threads == threads
     assert est.grid_nodes == int(np.prod(m.grid_shape))
     assert est.grid == st.grid_m_all.capacity + st.grid_p_all.capacity
     others = sum(a.capacity for k, a in vars(st).items() if isinstance(a, wp.array)
                  and k not in ("grid_m_all", "grid_p_all", "grid_m", "grid_p"))
     assert others < 4096                                   # dt, speed bounds, counters, wall impulses
-    assert est.host == sim.x0.nbytes + sum(x.nbytes for _, x in m._seed)
+    assert est.host == sim.x0.nbytes + sum(x.nbytes for _, x in m._seed) + \
+        sum(g.columns.nbytes for g in m.groups if g.columns is not None)
     s = 8 if sc.precision == "float64" else 4
     d = m.dim
     assert est.staging == m.n_particles * (2 * d + d * d) * s

@@ -3,8 +3,8 @@
 The layer of :func:`mpm_warp.scenes.weak_layer.calibration.weak_layer_material` (issue 10's PST
 layer: E 1 MPa, nu 0.3, rho 150, M 1.2, beta 0.3, D_wl 2 cm under a 0.5 m slab of
 density 250: sigma_n = 1226 Pa; tau_p 1 kPa, w_f 0.3 J/m^2, WEAC collapse
-height) is driven through F-level paths by the temporary material-point
-driver :mod:`mpm_warp.bonded_point` (mixed control: the Cauchy normal stress
+height) is driven through F-level paths by the shared material-point
+driver :mod:`mpm_warp.material_point` (mixed control: the Cauchy normal stress
 held by a root find on the stretch across the layer).
 
 Measured (float64, CPU) and the bounds asserted:
@@ -33,7 +33,6 @@ import numpy as np
 import pytest
 import warp as wp
 
-from mpm_warp.bonded_point import drive_bonded, total_path
 from mpm_warp.errors import InvalidArgument, ScenarioError
 from mpm_warp.loader import material_from_table
 from mpm_warp.materials import BondedCamClay
@@ -43,7 +42,14 @@ from mpm_warp.scenes.weak_layer.calibration import (
     weac_collapse_height,
     weak_layer_material,
 )
-from mpm_warp.scenes.weak_layer.paths import collapse_law, compressive_strength, loaded_shear_test, shear_strength
+from mpm_warp.scenes.weak_layer.paths import (
+    collapse_law,
+    compressive_strength,
+    drive_layer,
+    loaded_shear_test,
+    shear_strength,
+    simple_shear_path,
+)
 from mpm_warp.validation.weak_layer import consolidation_pressure
 
 wp.config.quiet = True
@@ -71,8 +77,8 @@ def test_oedometric_first_yield_at_the_compressive_strength(layer):
     lam_end = math.exp(-2.0 * sc / (mat.lam + 2 * mat.mu))
     F = np.repeat(np.eye(3)[None], 2000, 0)
     F[:, 1, 1] = np.exp(np.linspace(0.0, math.log(lam_end), 2001)[1:])
-    r = drive_bonded(mat, F)
-    sv = -_first_plastic({"s": r["sigma"][..., 1, 1], "yielded": r["yielded"], "bond": r["bond"]}, "s")
+    r = drive_layer(mat, F)
+    sv = -_first_plastic({"s": r["stress"][..., 1, 1], "yielded": r["yielded"], "bond": r["bond"]}, "s")
     print(f"oedometric first yield {sv:.2f} Pa against {sc:.2f} Pa")
     assert abs(sv / sc - 1) < 1e-2
 
@@ -84,7 +90,7 @@ def test_shear_first_yield_at_the_shear_strength(layer):
     print(f"shear first yield {tau_y:.2f} Pa, peak {r['tau_peak']:.2f} Pa, closed form {layer.tau_p:.2f} Pa")
     assert abs(tau_y / layer.tau_p - 1) < 1e-2 and abs(layer.tau_p / 1000.0 - 1) < 1e-9
     assert abs(shear_strength(mat, SIGMA_N) / 1000.0 - 1) < 1e-9
-    sig = drive_bonded(mat, total_path(np.linspace(0.0, 0.01, 401)), np.full(401, -SIGMA_N))["sigma"]
+    sig = drive_layer(mat, simple_shear_path(np.linspace(0.0, 0.01, 401)), np.full(401, -SIGMA_N))["stress"]
     assert np.abs(sig[0, 1:, 1, 1] / -SIGMA_N - 1).max() < 1e-9  # the held normal stress
 
 
@@ -92,7 +98,7 @@ def test_isotropic_first_yield_at_the_cap(layer):
     mat = layer.material
     e_end = -2.0 * mat.p0_ini / mat.bulk
     F = np.exp(np.linspace(0.0, e_end, 2001)[1:] / 3.0)[:, None, None] * np.eye(3)
-    r = drive_bonded(mat, F)
+    r = drive_layer(mat, F)
     p = _first_plastic({"p": r["p"][None, 0], "yielded": r["yielded"], "bond": r["bond"]}, "p")
     print(f"isotropic first yield {p:.2f} Pa against p0 = {mat.p0_ini:.2f} Pa")
     assert abs(p / mat.p0_ini - 1) < 1e-2
@@ -137,7 +143,7 @@ def test_debonded_layer_collapses_by_the_law_and_the_calibrated_height(layer):
     mat = layer.material
     n = 400
     F = np.repeat(np.eye(3)[None], n, 0)
-    r = drive_bonded(mat, F, -SIGMA_N * np.minimum(np.arange(1, n + 1) / (n / 2), 1.0), kappa_ini=mat.kappa_s)
+    r = drive_layer(mat, F, -SIGMA_N * np.minimum(np.arange(1, n + 1) / (n / 2), 1.0), kappa0=mat.kappa_s)
     c_end = 1 - math.exp(r["log_jp"][0, -1] - mat.initial_log_jp)
     p0_end = float(consolidation_pressure(r["p"][0, -1], r["q"][0, -1], mat.M, 0.0))
     law = float(collapse_law(mat, p0_end))
@@ -159,7 +165,7 @@ def test_collapse_after_shear_and_after_isotropic_crushing_follows_the_law(layer
     assert c_shear > layer.h_c / layer.D_wl  # sheared: p0 above the oedometric one (MODEL.md 3b)
     # isotropic compression beyond the intact strength: the bond breaks by compaction, then the intrinsic law
     e_end = -np.linspace(0.0, 0.5, 1001)[1:]
-    iso = drive_bonded(mat, np.exp(e_end / 3.0)[:, None, None] * np.eye(3))
+    iso = drive_layer(mat, np.exp(e_end / 3.0)[:, None, None] * np.eye(3))
     assert iso["bond"][0, -1] == 0.0 and np.max(-np.diff(iso["bond"][0])) < 0.1
     c_iso = 1 - math.exp(iso["log_jp"][0, -1] - mat.initial_log_jp)
     c_iso_law = float(collapse_law(mat, iso["p"][0, -1]))
@@ -240,14 +246,14 @@ def test_material_rejects_bad_parameters(field, value):
 
 def test_driver_rejects_bad_input(layer):
     with pytest.raises(InvalidArgument) as e:
-        drive_bonded(layer.material, np.zeros((2, 3)))
-    assert e.value.field == "F_path"
+        drive_layer(layer.material, np.zeros((2, 3)))
+    assert e.value.field == "F_total"
     with pytest.raises(InvalidArgument) as e:
-        drive_bonded(layer.material, np.eye(3)[None], kappa_ini=-1.0)
-    assert e.value.field == "kappa_ini"
+        drive_layer(layer.material, np.eye(3)[None], kappa0=-1.0)
+    assert e.value.field == "kappa0"
     with pytest.raises(InvalidArgument) as e:
-        drive_bonded(BondedCamClay(1e6, 0.3, 150.0, beta=2.0, kappa_s=math.inf), np.eye(3)[None])
-    assert e.value.field == "material.beta"
+        drive_layer(BondedCamClay(1e6, 0.3, 150.0, beta=2.0, kappa_s=math.inf), np.eye(3)[None])
+    assert e.value.field == "material[0].beta"
 
 
 def test_material_from_table():

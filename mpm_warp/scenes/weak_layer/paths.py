@@ -17,7 +17,7 @@ strain has ``eps = (0, ln lambda, 0)``; simple shear ``eps = ln(F F^T)/2``,
 solved by Newton in ``(ln lambda, gamma)``. The yield test of a state is
 :func:`mpm_warp.validation.weak_layer.consolidation_pressure` (the ellipse
 through ``(p, q)``). The softening part has no closed form: it is measured on
-the material-point driver (:mod:`mpm_warp.bonded_point`).
+the material-point driver (:mod:`mpm_warp.material_point`, the engine's update).
 
 Definitions (per unit area of the layer of thickness ``D_wl``; the
 material point is the layer, uniform across its thickness):
@@ -39,8 +39,8 @@ import math
 
 import numpy as np
 
-from ...bonded_point import drive_bonded, total_path
 from ...errors import InvalidArgument
+from ...material_point import drive_material_points
 from ...materials import BondedCamClay
 from ...validation.weak_layer import consolidation_pressure, oedometric_point, oedometric_ratio
 
@@ -48,6 +48,30 @@ __all__ = [
     "compressive_strength", "elastic_shear_state", "shear_strength", "bond_pressure_for_shear_strength",
     "collapse_law", "oedometric_collapse", "xi_for_collapse", "loaded_shear_test",
 ]
+
+
+def simple_shear_path(gamma, stretch_y=1.0) -> np.ndarray:
+    """Total deformation gradients ``[[1, gamma, 0], [0, stretch_y, 0], [0, 0, 1]]`` (simple shear of ``x``
+    along the layer normal ``y`` with lateral confinement), shape ``(n, 3, 3)``."""
+    g = np.atleast_1d(np.asarray(gamma, dtype=np.float64))
+    F = np.repeat(np.eye(3)[None], len(g), axis=0)
+    F[:, 0, 1] = g
+    F[:, 1, 1] = stretch_y
+    return F
+
+
+def drive_layer(mat: BondedCamClay, F_total, sigma_yy=None, *, kappa0=None, dtype: str = "float64",
+                device=None) -> dict:
+    """The shared material-point driver (:func:`mpm_warp.material_point.drive_material_points`) on total paths
+    ``F_total`` (n, 3, 3), with the bed-normal Cauchy stress ``sigma_yy`` (Pa, tension positive; one per
+    increment, NaN: not held) held by solving ``F_yy``: the layer under its slab. ``kappa0``: a debonded start."""
+    control = None
+    if sigma_yy is not None:
+        s = np.asarray(sigma_yy, dtype=np.float64)
+        nan = np.full_like(s, np.nan)
+        control = {"axes": (False, True, False), "sigma": np.stack([nan, s, nan], axis=-1)}
+    return drive_material_points(F_total=F_total, material=mat, kappa0=kappa0, stress_control=control, dtype=dtype,
+                                 device=device)
 
 
 def _hencky_cauchy(mat, lam_y: float, gamma: float) -> np.ndarray:
@@ -223,8 +247,8 @@ def loaded_shear_test(mat: BondedCamClay, sigma_n: float, D_wl: float, gamma_end
     if n < 2:
         raise InvalidArgument("n_increments", n_increments, "an integer >= 2")
     gamma = np.concatenate([[0.0], np.linspace(0.0, gamma_end, n + 1)[1:]])
-    r = drive_bonded(mat, total_path(gamma), np.full(len(gamma), -float(sigma_n)), dtype=dtype, device=device)
-    s = r["sigma"][0].astype(np.float64)
+    r = drive_layer(mat, simple_shear_path(gamma), np.full(len(gamma), -float(sigma_n)), dtype=dtype, device=device)
+    s = r["stress"][0].astype(np.float64)
     FE = r["F_E"][0].astype(np.float64)
     tau = s[1:, 0, 1]
     gam = gamma
