@@ -319,13 +319,14 @@ def _block(b: Block, i: int, mats: dict, dom: Domain) -> Block:
     for a in range(dim):
         if bhi[a] <= blo[a]:
             raise InvalidArgument(f"{w}.hi[{a}]", bhi[a], f"a number > {w}.lo[{a}] = {blo[a]:g}")
-        if dx > (bhi[a] - blo[a]) * (1 + 1e-9):
-            raise InvalidArgument("domain.dx", dx, f"a spacing at most the smallest block extent: {w} spans "
-                                  f"{bhi[a] - blo[a]:g} m along {'xyz'[a]} (a block thinner than a cell is one "
-                                  "layer of particles the grid cannot resolve)")
         if blo[a] < lo[a] - 1e-9 * dx or bhi[a] > hi[a] + 1e-9 * dx:
             raise InvalidArgument(f"{w}.lo/hi[{a}]", (blo[a], bhi[a]),
                                   f"inside the domain [{lo[a]:g}, {hi[a]:g}] (particles inside the grid)")
+    size = [bhi[a] - blo[a] for a in range(dim)]
+    if dx > max(size) * (1 + 1e-9):        # a layer thinner than a cell (one particle across) is fine; a block
+        raise InvalidArgument("domain.dx", dx, (  # inside one cell is a few particles the grid cannot resolve
+            f"a spacing at most the largest extent of every block: {w} is " + " x ".join(f"{e:g}" for e in size)
+            + " m, inside one cell"))
     ppc = positive_int(f"{w}.particles_per_cell", b.particles_per_cell, lo=1, hi=8)
     vel = b.velocity if callable(b.velocity) else vector(
         f"{w}.velocity", (0.0,) * dim if b.velocity is None else b.velocity, dim)
