@@ -339,12 +339,13 @@ class State:
             self.hzz.assign((F[:, 2, 2] - 1.0).astype(self.model.np_dtype))
 
     def arrays(self) -> dict[str, np.ndarray]:
-        """Host copies of the full state (for checkpoints)."""
+        """Host copies of the full state (checkpoints, snapshots): copies, never views of the device
+        memory (on the CPU ``wp.array.numpy()`` is a view, which the next step would overwrite)."""
         d = {}
         for k in self.CHECKPOINT_FIELDS:
             a = getattr(self, k)
             if a is not None:
-                d[k] = a.numpy()
+                d[k] = np.array(a.numpy(), copy=True)
         return d
 
     def load_arrays(self, d: dict[str, np.ndarray]) -> None:

@@ -14,10 +14,10 @@ from collections.abc import Callable
 import numpy as np
 import warp as wp
 
-from . import io
+from . import io, snapshot
 from .config import OUTPUT_FIELDS, Scenario
 from .device import resolve_device
-from .errors import InvalidArgument, OutputError, SimulationBlowUp
+from .errors import InvalidArgument, SimulationBlowUp
 from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_kernel
 from .memory import check_memory
 from .model import Model, ParticleGroup, State, material_params
@@ -414,57 +414,22 @@ class Simulation:
             out.update(m.frame_scalars(self))
         return out
 
+    def snapshot(self) -> tuple[dict[str, np.ndarray], dict]:
+        """The whole state of the run in memory (:func:`mpm_warp.snapshot.take_snapshot`): what a checkpoint holds."""
+        return snapshot.take_snapshot(self)
+
+    def load_snapshot(self, arrays: dict[str, np.ndarray], meta: dict) -> None:
+        """Continue from a :meth:`snapshot` (:func:`mpm_warp.snapshot.load_snapshot`); e.g. a fork."""
+        snapshot.load_snapshot(self, arrays, meta)
+
     def _checkpoint(self, path: str | None) -> None:
-        if path is None:
-            return
-        t, _, steps = self.stepper.clock()
-        meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device,
-                "monitors": sorted(self.monitors), "time": t, "step": steps,
-                "last_frame_time": getattr(self, "_last_frame_time", t)}
-        arrays = self.state.arrays()
-        # the next step's speed bound, so resume is bit for bit; one number, so any thread count or device resumes
-        arrays["vmax"] = np.asarray([self.stepper.vmax.numpy().max()])
-        if self.stepper.wall_impulses is not None:   # the impulse of a frame stopped half-way
-            arrays["wall_impulses"] = self.stepper.wall_impulses.numpy()
-        for name, m in self.monitors.items():
-            arrays.update({f"monitors/{name}/{k}": np.asarray(a) for k, a in m.state().items()})
-        io.write_checkpoint(path, arrays, meta)
+        if path is not None:
+            io.write_checkpoint(path, *self.snapshot())
 
     def restore(self, output: str) -> None:
-        """Load the last checkpoint of the run file ``output``: state, step bound, monitors, frame count.
+        """Load the last checkpoint of the run file ``output`` (:func:`mpm_warp.snapshot.restore_run`).
 
         Attach the same monitors first (their state is restored into them); on the CPU the run then
         continues bit for bit as if never stopped.
         """
-        ckpt = io.checkpoint_path_for(output)
-        arrays, meta = io.read_checkpoint(ckpt)
-        run = io.read_run(output)
-        k = int(meta["frame_index"])
-        if run.n_frames <= k:
-            raise OutputError(f"{output}: holds {run.n_frames} complete frames, its checkpoint {ckpt} is at frame {k}: "
-                              "they are not of the same run")
-        for i in range(k + 1):                  # every frame the resume keeps must read (HDF5 checksums)
-            kept = run.frame(i)
-        if meta.get("time") == run.times[k] and not np.array_equal(kept["x"], arrays["x"]):
-            raise OutputError(f"{output}: frame {k} differs from the state of its checkpoint {ckpt} at the same time; "
-                              "the file is damaged or not of this run (resume refused: it would keep that frame)")
-        if set(meta.get("monitors", [])) != set(self.monitors):
-            raise OutputError(f"{ckpt}: holds the state of the monitors {sorted(meta.get('monitors', []))}, "
-                              f"this simulation has {sorted(self.monitors)}")
-        self.state.load_arrays(arrays)
-        if "vmax" in arrays:
-            self.stepper.vmax.fill_(float(np.max(arrays["vmax"])))
-        else:
-            self.stepper.seed_vmax()
-        for name, m in self.monitors.items():
-            prefix = f"monitors/{name}/"
-            m.load_state({k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)})
-        if "wall_impulses" in arrays and self.stepper.wall_impulses is not None:
-            imp = arrays["wall_impulses"]
-            if imp.shape[:2] != self.stepper.wall_impulses.shape:   # another thread count: the sum in one slot
-                imp = np.concatenate([imp.sum(axis=0, keepdims=True),
-                                      np.zeros((self.stepper.wall_impulses.shape[0] - 1, *imp.shape[1:]))])
-            self.stepper.wall_impulses.assign(imp)
-        self.frame_index = k
-        self._last_frame_time = float(meta.get("last_frame_time", self.time))
-        self.x0[...] = run.static["x0"]
+        snapshot.restore_run(self, output)

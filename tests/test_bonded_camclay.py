@@ -24,7 +24,6 @@ import numpy as np
 import pytest
 import warp as wp
 
-from mpm_warp.errors import InvalidArgument
 from mpm_warp.kernels.bonded_camclay import (
     bonded_camclay_return_func,
     bonded_p0_func,

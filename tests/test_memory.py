@@ -9,12 +9,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import warp as wp
+from helpers_scenes import TINY_PST
 
 import mpm_warp as mw
 from mpm_warp.memory import available_memory, check_memory, estimate_memory, format_bytes, parse_bytes, particle_bytes
 
-TINY_PST = ["scene.length=0.6", "scene.slab_thickness=0.15", "scene.saw.cut_length=0.15", "time.end=0.01",
-            "time.frame_interval=0.005", 'output.fields=["x", "log_jp", "yielded"]']
+PST = TINY_PST + ["time.end=0.01", 'output.fields=["x", "log_jp", "yielded"]']
 
 
 def _plane_block(precision: str) -> mw.Scenario:
@@ -45,7 +45,7 @@ SCENES = {
     "block-float64-2-threads": lambda: (mw.load_scenario("elastic_block", ['precision="float64"']), 2),
     "plane-strain-float32": lambda: (_plane_block("float32"), 1),
     "plane-strain-float64-camclay": lambda: (_plane_block("float64"), 2),
-    "pst-camclay-yielded": lambda: (mw.load_scenario("pst_demo", TINY_PST), 1),
+    "pst-bonded-yielded": lambda: (mw.load_scenario("pst_demo", PST), 1),
     "bonded-3d-float32-2-threads": lambda: (_bonded_layer(3, "float32"), 2),
     "bonded-2d-float64": lambda: (_bonded_layer(2, "float64"), 1),
 }

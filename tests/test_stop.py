@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 import pytest
+from helpers_scenes import TINY_PST
 
 import mpm_warp as mw
 from mpm_warp import io
@@ -78,9 +79,7 @@ def test_block_stopped_mid_frame_resumes_bit_for_bit(tmp_path):
 
 def test_pst_stopped_mid_frame_while_sawing_resumes_bit_for_bit(tmp_path):
     """A PST stopped half-way through a frame after settling (the saw cutting, yielded flags half collected)."""
-    overrides = ["scene.length=0.6", "scene.slab_thickness=0.15", "scene.saw.cut_length=0.15",
-                 "scene.settle.gravity_ramp=0.02", "scene.settle.duration=0.04", "time.end=0.065",
-                 "time.frame_interval=0.005", "output.checkpoint_every=4", 'output.fields=["x", "log_jp", "yielded"]']
+    overrides = TINY_PST + ["time.end=0.065", "output.checkpoint_every=4", 'output.fields=["x", "log_jp", "yielded"]']
     full, res = _stopped_mid_frame_then_resumed(tmp_path, "pst_demo", overrides, lambda s: s.time > 0.0525)
     assert full.monitor.series == res.monitor.series and full.scene_result.keys() == res.scene_result.keys()
     for k in full.scene_result:

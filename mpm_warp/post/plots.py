@@ -5,7 +5,7 @@ and, for fits, ``<name>.json``. Figures are made only for the series a run has:
 
 - ``front``: crack front position against time, with the speed of a straight-line fit on the
   steady part of its travel (``front_position``, x [m], or a PST's ``front``, distance from the
-  saw's starting end [m]; the saw's position and the failure front too when stored);
+  saw's starting end [m]; the saw's position and the slab-deflection front too when stored);
 - ``markers``: slab marker displacements ``marker_<k>_dx|dy`` (or ``marker<k>_ux|uy``) against time;
 - ``shear``: shear stress (and Mises stress q) and axial strain against shear strain
   (``shear_strain`` with ``shear_stress``, ``mises_q``, ``axial_strain``);
@@ -75,16 +75,16 @@ def plot_front(run: RunData, out_dir: str) -> list[str]:
     """Front position against time with the fitted speed: ``front.png``, ``.csv``, ``.json``.
 
     The front is ``front_position`` (x [m]) or a PST's ``front`` (distance from the saw's end
-    [m]; with ``failure_front`` and ``saw`` beside it). The fit is :func:`mpm_warp.post.fronts.front_speed`
-    (for a PST the window of the PST's own result: 30 % to 85 % of the way from the cut to the far end).
+    [m], the damage front; with ``deflection_front`` and ``saw`` beside it). The fit is
+    :func:`mpm_warp.post.fronts.front_speed` (for a PST over the positions of the PST's own mean speed).
     """
     name = front_name(run)
     t, xf = run.times, run.scalars[name]
     fit = front_speed(run)
     fig, (ax,) = _figure()
-    ax.plot(t, xf, "o-", ms=3, lw=1, color="C0", label="crack front")
+    ax.plot(t, xf, "o-", ms=3, lw=1, color="C0", label="crack front" if name == "front_position" else "damage front")
     columns = {"time [s]": t, f"{name} [{_unit(run, name)}]": xf}
-    for other, style, label in (("failure_front", ":", "failure front"), ("saw_position", "--", "saw"),
+    for other, style, label in (("deflection_front", ":", "slab-deflection front"), ("saw_position", "--", "saw"),
                                 ("saw", "--", "saw")):
         if other in run.scalars:
             ax.plot(t, run.scalars[other], style, color="0.4", label=label)

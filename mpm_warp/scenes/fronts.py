@@ -171,13 +171,19 @@ def speed_profile(s, T, window: float, start: float = 0.0) -> tuple[np.ndarray, 
 
 
 def mean_speed(s, T, s0: float, s1: float) -> float:
-    """Mean front speed (m/s) from ``s0`` to ``s1`` (m) on the path ``(s, T)``: ``(s1 - s0) / (T(s1) - T(s0))``;
-    nan if the front did not reach ``s1``."""
+    """Mean front speed (m/s) from ``s0`` to ``s1`` (m) on the path ``(s, T)``; nan if the front did not reach ``s1``.
+
+    Measured from the first station at or beyond ``s0`` (the bins before it, e.g. the saw's, do not
+    enter): ``(s1 - s_a) / (T(s1) - T(s_a))``, ``T(s1)`` interpolated.
+    """
     s, T = np.asarray(s, dtype=float), np.asarray(T, dtype=float)
     if not len(s) or s[-1] < s1 or s[0] > s0:
         return math.nan
-    dt = float(np.interp(s1, s, T) - np.interp(s0, s, T))
-    return (s1 - s0) / dt if dt > 0 else math.inf
+    a = int(np.searchsorted(s, s0 - 1e-12))
+    if a >= len(s) or s[a] >= s1:
+        return math.nan
+    dt = float(np.interp(s1, s[a:], T[a:]) - T[a])
+    return (s1 - float(s[a])) / dt if dt > 0 else math.inf
 
 
 def lead_ahead_of_front(s, t_arrival) -> tuple[float, float]:

@@ -27,7 +27,7 @@ Fronts (documented criteria, distances from the saw's end of the column, m; bins
 
 Speeds are profiles along the fronts' paths, the touchdown distance is measured behind the
 deflection front, and the critical cut length comes from bisection on the saw's stop position
-(:func:`mpm_warp.scenes.fronts.critical_cut_length`) or, from one run, the saw position when the
+(:func:`critical_cut`, trial runs forked from one base run) or, from one run, the saw position when the
 crack ran away from the blade (``runaway_cut``); :mod:`.analysis`.
 
 Resolution: the weak layer must span at least three grid cells
@@ -36,7 +36,8 @@ share a grid node); four resolve it (the ready scenes).
 
 Modules: :mod:`.params` (:class:`PSTParams` and its derived values), :mod:`.build`,
 :mod:`.kernels` (the deflection tracker; the saw is the weak layer's), :mod:`.monitor`
-(:class:`PSTMonitor`), :mod:`.analysis` (:func:`pst_summary`); the closed forms in
+(:class:`PSTMonitor`), :mod:`.analysis` (:func:`pst_summary`), :mod:`.critical` (:func:`critical_cut`:
+bisection over trial runs forked from one base run); the closed forms in
 :mod:`mpm_warp.scenes.references`.
 """
 
@@ -45,11 +46,12 @@ from ..references import critical_cut_length_formula, heierli_speed, heierli_tou
 from ..snow import SETTLE_TIME_KEYS
 from .analysis import pst_summary
 from .build import build
+from .critical import CriticalCut, critical_cut
 from .monitor import PSTMonitor, attach
 from .params import Front, PSTParams, Saw
 
-__all__ = ["SCENE", "PSTParams", "Saw", "Front", "build", "attach", "PSTMonitor", "pst_summary", "heierli_speed",
-           "heierli_touchdown", "critical_cut_length_formula"]
+__all__ = ["SCENE", "PSTParams", "Saw", "Front", "build", "attach", "PSTMonitor", "pst_summary", "critical_cut",
+           "CriticalCut", "heierli_speed", "heierli_touchdown", "critical_cut_length_formula"]
 
 SCENE = SceneType(
     kind="pst", params=PSTParams, build=build, attach=attach, time_keys=SETTLE_TIME_KEYS,

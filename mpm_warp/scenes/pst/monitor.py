@@ -88,9 +88,9 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         """Frame scalars (see the class docstring)."""
         t = sim.time
         p = self.params
-        bin_w, L = p.bin_width, float(p.length)
+        bin_w = p.bin_width
         deflection = self.deflection_front(t)
-        out = {"front": min(front_from_arrival(self.damage_arrival(), t, bin_w), L),
+        out = {"front": self.damage_front(t),
                "deflection_front": deflection, "saw": self.saw_position(t)}
         c, sawn = self.weak.collapse()
         gone = (self.weak.bond() <= 0.0) & (sawn == 0)
@@ -137,6 +137,11 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         """Deflection time of every bin (s; inf: not yet): the median of its slab-base particles' times."""
         p = self.params
         return bin_median(self.s_base, self.base_arrival.numpy(), p.bin_width, p.n_bins)
+
+    def damage_front(self, t: float) -> float:
+        """The damage front at time ``t`` (m from the cut end)."""
+        p = self.params
+        return min(front_from_arrival(self.damage_arrival(), t, p.bin_width), float(p.length))
 
     def deflection_front(self, t: float) -> float:
         """The slab-deflection front at time ``t`` (m from the cut end)."""

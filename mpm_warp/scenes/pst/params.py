@@ -194,7 +194,7 @@ class PSTParams:
         """Closed-form references of this PST (:mod:`mpm_warp.scenes.references`) with the calibrated layer.
 
         ``sigma_n``, ``p_oedometric`` (Pa); the layer's ``tau_p`` (Pa), ``w_f`` (J/m^2), ``delta_s``
-        (m), ``collapse_height`` (m, the debonded layer under this slab at rest); Heierli's
+        (m), ``collapse_height_calibrated`` (m, the debonded layer under this slab at rest); Heierli's
         ``heierli_speed`` (m/s) and ``heierli_touchdown`` (m) with that collapse height; Gaume et al.
         (2017) ``critical_cut_gaume`` (m, flat ground); the slab's ``rayleigh_speed`` and
         ``shear_wave_speed`` (m/s).
@@ -203,7 +203,7 @@ class PSTParams:
         slab = self.slab.material()
         D = self.slab_thickness
         return {"sigma_n": self.sigma_n, "p_oedometric": oedometric_pressure(self.sigma_n, wl.material.nu),
-                "tau_p": wl.tau_p, "w_f": wl.w_f, "delta_s": wl.delta_s, "collapse_height": wl.h_c,
+                "tau_p": wl.tau_p, "w_f": wl.w_f, "delta_s": wl.delta_s, "collapse_height_calibrated": wl.h_c,
                 "heierli_speed": heierli_speed(slab.E, D, slab.density, wl.h_c),
                 "heierli_touchdown": heierli_touchdown(slab.E, D, slab.density, wl.h_c),
                 "critical_cut_gaume": float(wl.critical_cut) if wl.critical_cut is not None else math.nan,

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...materials import hardening_collapse
 from .params import ShearTestParams
 
 __all__ = ["ShearSummary", "shear_summary", "shear_curves", "analyze_shear_series"]
@@ -39,7 +40,11 @@ def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
     softening displacement ``delta_s`` is the slip from the peak to the loss of the bond (the layer's
     mean bond at zero: the end of the strength drop, before the collapse and the frictional residual);
     the same on the block's displacement (``plate_``) for comparison with the loading-plate measurement
-    of a shear test. The calibrated layer's predictions (:meth:`ShearTestParams.references`) are copied in.
+    of a shear test. The collapse is given beside two laws: ``collapse_fraction_law`` (oedometric, the
+    debonded layer under the slab at rest) and ``collapse_fraction_critical_state`` (the debonded,
+    cohesionless layer at the critical state of its final mean Kirchhoff pressure ``p_final``: ``p0 =
+    2 p``; a sheared layer compacts more, MODEL.md 3b). The calibrated layer's predictions
+    (:meth:`ShearTestParams.references`) are copied in.
     """
     c = shear_curves(params, times, series)
     if len(c["u"]) < 3:
@@ -49,11 +54,17 @@ def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
     k = int(lost[0]) if len(lost) else -1
     ip = sm.peak_index
     refs = params.references()
+    mat = params.calibrated().material
+    p_end = float(np.asarray(series.get("p_kirchhoff", [math.nan]), dtype=float)[-1])
+    # the debonded layer (cohesion beta b = 0) at the critical state: p0 = 2 p, p the Kirchhoff pressure
+    cs = hardening_collapse(2.0 * p_end, mat.bulk, mat.xi, mat.p0_int_ini) \
+        if np.isfinite(p_end) and p_end > 0 else math.nan
     return {"peak_shear_stress": sm.peak_stress, "residual_shear_stress": sm.residual_stress,
             "peak_slip": float(c["slip"][ip]),
             "softening_displacement": float(c["slip"][k] - c["slip"][ip]) if k >= 0 else math.nan,
             "plate_softening_displacement": float(c["u"][k] - c["u"][ip]) if k >= 0 else math.nan,
-            "bond_lost": k >= 0, "collapse_fraction": sm.collapse_fraction, "peak_q": float(np.max(c["q"])),
+            "bond_lost": k >= 0, "collapse_fraction": sm.collapse_fraction,
+            "collapse_fraction_critical_state": float(cs), "p_final": p_end, "peak_q": float(np.max(c["q"])),
             **{f"{key}_calibrated" if key in ("delta_s", "w_f", "tau_p", "tau_peak") else key: float(v)
                for key, v in refs.items()}}
 

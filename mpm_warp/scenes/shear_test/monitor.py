@@ -27,7 +27,8 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
     equals the substratum's shear reaction, by momentum balance), ``layer_shear_stress`` (Pa, mean
     Cauchy ``sigma_xy`` of the weak-layer particles from the device's stress field: lower, since the
     free ends carry none and part of the push reaches the layer's top through the shared grid
-    nodes), ``mises_q``/``p_mean`` (Pa, mean Mises stress and pressure of the weak layer, Kirchhoff),
+    nodes), ``mises_q``/``p_mean`` (Pa, mean Mises stress and pressure of the weak layer, Cauchy), ``p_kirchhoff``
+    (Pa, its mean Kirchhoff pressure, the yield function's),
     ``collapse`` (-, mean ``1 - J_P/J_P,ref`` of the layer), ``bond`` (-, the layer's mean bond
     ``1 - kappa/kappa_s``) and ``damaged_fraction`` (-, bond at or below one half). Per-frame particle
     field (with ``log_jp`` in the output): ``log_jp_ref``, the collapse reference.
@@ -36,7 +37,8 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
     name = "shear_test"
     UNITS = {"shear_displacement": "m", "normal_displacement": "m", "layer_slip": "m", "shear_strain": "1",
              "axial_strain": "1",
-             "layer_shear_stress": "Pa", "shear_stress": "Pa", "mises_q": "Pa", "p_mean": "Pa", "collapse": "1",
+             "layer_shear_stress": "Pa", "shear_stress": "Pa", "mises_q": "Pa", "p_mean": "Pa", "p_kirchhoff": "Pa",
+             "collapse": "1",
              "bond": "1", "damaged_fraction": "1"}
 
     def __init__(self, sim):
@@ -75,6 +77,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
         wl = self.weak.group
         p, q, sigma = sim.stresses(cauchy=True)
         sxy = sigma[wl.start:wl.end, 0, 1].astype(np.float64)
+        p_k = sim.stresses()[0][wl.start:wl.end]
         c, _ = self.weak.collapse()
         bond = self.weak.bond()
         d_wl = float(self.params.weak_layer_thickness)
@@ -89,6 +92,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
                 "shear_strain": float(u[0]) / d_wl, "axial_strain": -float(u[1]) / d_wl,
                 "layer_shear_stress": float(np.mean(sxy)),
                 "mises_q": float(np.mean(q[wl.start:wl.end])), "p_mean": float(np.mean(p[wl.start:wl.end])),
+                "p_kirchhoff": float(np.mean(p_k)),
                 "collapse": float(np.mean(c)), "bond": float(np.mean(bond)),
                 "damaged_fraction": float(np.mean(bond <= 0.5))}
 
