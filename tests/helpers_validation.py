@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from helpers_device import DEVICE  # noqa: F401  (re-exported: MPM_WARP_TEST_DEVICE)
 
 import mpm_warp as mw
 from mpm_warp.validation import (  # noqa: F401  (re-exported for the tests)
@@ -20,8 +21,6 @@ from mpm_warp.validation import (  # noqa: F401  (re-exported for the tests)
     observed_order,
     zero_crossings,
 )
-
-DEVICE = "cpu"
 
 
 # ------------------------------------------------------------------ measuring

@@ -23,6 +23,7 @@ import math
 import numpy as np
 import pytest
 import warp as wp
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 from mpm_warp.kernels.bonded_camclay import (
     bonded_camclay_return_func,
@@ -38,7 +39,6 @@ from mpm_warp.materials import BondedCamClay
 from mpm_warp.model import lattice_columns, lattice_counts, seed_block
 from mpm_warp.scenes.weak_layer.paths import drive_layer, simple_shear_path
 
-DEVICE = "cpu"
 TYPES = {"float32": (wp.float32, np.float32, 2.0**-24), "float64": (wp.float64, np.float64, 2.0**-53)}
 YIELD_TOL_U = 8.0
 PARAMS = ("mu", "lam", "M", "beta", "xi", "p0_floor", "p_bond", "kappa_s")

@@ -24,6 +24,7 @@ import functools
 import numpy as np
 import pytest
 import warp as wp
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 from mpm_warp.errors import InvalidArgument
 from mpm_warp.kernels.camclay import (
@@ -38,7 +39,6 @@ from mpm_warp.kernels.elasticity import hencky_func
 from mpm_warp.kernels.types import vec3
 from mpm_warp.material_point import drive_material_points, isotropic_compression, lame_parameters
 
-DEVICE = "cpu"
 TYPES = {"float32": (wp.float32, np.float32, 2.0**-24), "float64": (wp.float64, np.float64, 2.0**-53)}
 YIELD_TOL_U = 8.0
 YIELD_TOL_U_EXTREME = 32.0

@@ -13,11 +13,11 @@ import functools
 import numpy as np
 import pytest
 import warp as wp
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 from mpm_warp.kernels.elasticity import clamp_singular_func, hencky_energy_func, hencky_func
 from mpm_warp.kernels.types import mat33, vec3
 
-DEVICE = "cpu"
 TYPES = {"float32": (wp.float32, np.float32, 2.0**-24), "float64": (wp.float64, np.float64, 2.0**-53)}
 S_FLOOR = 1e-6
 

@@ -7,6 +7,7 @@ steps a graph holds and replays them eagerly: this checks the batching logic
 
 import numpy as np
 import warp as wp
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
 
@@ -48,7 +49,7 @@ class _FakeGraphs:
 
 def _run(use_graph, monkeypatch=None):
     sc = mw.load_scenario("elastic_block", ["time.end=0.05", "time.frame_interval=0.01"])
-    sim = mw.Simulation(sc, device="cpu", use_graph=use_graph)
+    sim = mw.Simulation(sc, device=DEVICE, use_graph=use_graph)
     fake = None
     if use_graph:
         fake = _FakeGraphs(sim.stepper)
@@ -70,7 +71,7 @@ def test_graph_batches_match_eager_bit_for_bit(monkeypatch):
 def test_exact_step_counts_with_graphs(monkeypatch):
     """steps(n) runs exactly n steps: whole graphs plus an eager remainder."""
     sc = mw.load_scenario("elastic_block", ["time.end=1.0"])
-    sim = mw.Simulation(sc, device="cpu", use_graph=True)
+    sim = mw.Simulation(sc, device=DEVICE, use_graph=True)
     fake = _FakeGraphs(sim.stepper)
     monkeypatch.setattr(wp, "ScopedCapture", fake.capture)
     monkeypatch.setattr(wp, "capture_launch", fake.launch)

@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 import warp as wp
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
 from mpm_warp.errors import InvalidArgument, ScenarioError
@@ -16,7 +17,6 @@ from mpm_warp.scenes.pst.kernels import deflection_kernel
 from mpm_warp.scenes.pst.monitor import attach
 from mpm_warp.scenes.weak_layer import weak_layer_kernel
 
-DEVICE = "cpu"
 G = 9.81
 
 

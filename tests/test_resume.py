@@ -8,6 +8,7 @@ import time
 
 import numpy as np
 import pytest
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 from helpers_scenes import TINY_PST
 
 import mpm_warp as mw
@@ -18,7 +19,7 @@ TINY = ["time.end=0.06", "time.frame_interval=0.01", "output.checkpoint_every=2"
 
 def _run(path, overrides=TINY):
     sc = mw.load_scenario("elastic_block", overrides)
-    return mw.Simulation(sc, device="cpu").run(str(path))
+    return mw.Simulation(sc, device=DEVICE).run(str(path))
 
 
 def test_resumed_run_matches_uninterrupted_bit_for_bit(tmp_path):
@@ -27,9 +28,9 @@ def test_resumed_run_matches_uninterrupted_bit_for_bit(tmp_path):
     # the same run stopped after frame 3 (a checkpoint exists at frame 2), then resumed
     part = tmp_path / "part.h5"
     sc = mw.load_scenario("elastic_block", TINY)
-    mw.Simulation(sc, device="cpu").run(str(part), callback=lambda sim, k: k < 3)
+    mw.Simulation(sc, device=DEVICE).run(str(part), callback=lambda sim, k: k < 3)
     assert mw.read_run(str(part)).n_frames == 4  # frames 0..3
-    res = mw.resume(str(part), device="cpu")
+    res = mw.resume(str(part), device=DEVICE)
     a, b = mw.read_run(str(full)), mw.read_run(str(part))
     assert a.n_frames == b.n_frames == 7
     np.testing.assert_array_equal(a.times, b.times)
@@ -56,7 +57,8 @@ def test_cli_interrupted_by_signal_keeps_frames_and_resumes(tmp_path):
     """A real `mpm-warp run` gets SIGINT mid-run: it stops after a complete frame, exit 130, and resumes."""
     out = tmp_path / "cli.h5"
     cmd = [sys.executable, "-m", "mpm_warp.cli", "run", "elastic_block", "--out", str(out), "--quiet",
-           "--set", "time.end=0.3", "--set", "time.frame_interval=0.005", "--set", "output.checkpoint_every=50"]
+           "--set", "time.end=0.3", "--set", "time.frame_interval=0.005", "--set", "output.checkpoint_every=50",
+           "--device", DEVICE]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.time() + 120
     while time.time() < deadline:
@@ -74,7 +76,8 @@ def test_cli_interrupted_by_signal_keeps_frames_and_resumes(tmp_path):
     run = mw.read_run(str(out))
     assert 3 <= run.n_frames < 61
     assert os.path.exists(io.checkpoint_path_for(str(out)))
-    res = subprocess.run([sys.executable, "-m", "mpm_warp.cli", "resume", str(out)], capture_output=True, text=True,
+    res = subprocess.run([sys.executable, "-m", "mpm_warp.cli", "resume", str(out), "--device", DEVICE],
+                         capture_output=True, text=True,
                          timeout=300)
     assert res.returncode == 0, res.stderr
     run = mw.read_run(str(out))
@@ -98,16 +101,16 @@ def _same_result(a: dict, b: dict) -> None:
 
 def _interrupted_equals_uninterrupted(tmp_path, scene: str, overrides: list, t_stop: float, device_keys) -> None:
     """Run straight through; run again stopped at ``t_stop`` (after settling) and resumed: bit for bit equal."""
-    full = mw.run(scene, str(tmp_path / "full.h5"), "cpu", overrides, n_threads=1)
+    full = mw.run(scene, str(tmp_path / "full.h5"), DEVICE, overrides, n_threads=1)
     part = str(tmp_path / "part.h5")
-    stopped = mw.run(scene, part, "cpu", overrides, n_threads=1, callback=lambda sim, k: sim.time < t_stop - 1e-12)
+    stopped = mw.run(scene, part, DEVICE, overrides, n_threads=1, callback=lambda sim, k: sim.time < t_stop - 1e-12)
     assert stopped.sim_time == pytest.approx(t_stop)
     arrays, meta = io.read_checkpoint(io.checkpoint_path_for(part))
     name = stopped.monitor.name
     assert meta["monitors"] == [name] and arrays["vmax"].size == 1
     for k in device_keys:   # the scene's device state at the stop is not trivial: losing it would show
         assert f"monitors/{name}/device/{k}" in arrays
-    res = mw.resume(part, device="cpu", n_threads=1)
+    res = mw.resume(part, device=DEVICE, n_threads=1)
     a, b = mw.read_run(str(tmp_path / "full.h5")), mw.read_run(part)
     assert a.n_frames == b.n_frames and a.particle_fields == b.particle_fields
     np.testing.assert_array_equal(a.times, b.times)
@@ -149,12 +152,12 @@ def test_shear_test_interrupted_while_pushing_resumes_bit_for_bit(tmp_path):
 def test_resume_on_another_thread_count(tmp_path):
     """vmax is stored as one number: a run checkpointed on 2 threads resumes on 1 (same steps, round-off apart)."""
     overrides = ["time.end=0.06", "time.frame_interval=0.01", "output.checkpoint_every=1"]
-    full = mw.run("elastic_block", str(tmp_path / "full.h5"), "cpu", overrides, n_threads=2)
+    full = mw.run("elastic_block", str(tmp_path / "full.h5"), DEVICE, overrides, n_threads=2)
     part = str(tmp_path / "part.h5")
-    mw.run("elastic_block", part, "cpu", overrides, n_threads=2, callback=lambda sim, k: k < 3)
+    mw.run("elastic_block", part, DEVICE, overrides, n_threads=2, callback=lambda sim, k: k < 3)
     arrays, _ = io.read_checkpoint(io.checkpoint_path_for(part))
     assert arrays["vmax"].size == 1 and arrays["vmax"] > 0.0
-    res = mw.resume(part, device="cpu", n_threads=1)
+    res = mw.resume(part, device=DEVICE, n_threads=1)
     a, b = mw.read_run(str(tmp_path / "full.h5")), mw.read_run(part)
     assert res.steps + int(b.steps[3]) == full.steps      # the same step sizes: the speed bound carried over
     np.testing.assert_allclose(b.frame(-1)["x"], a.frame(-1)["x"], atol=1e-6)

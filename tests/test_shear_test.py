@@ -9,13 +9,13 @@ import math
 
 import numpy as np
 import pytest
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
 from mpm_warp.errors import ScenarioError
 from mpm_warp.loader import load_scenario
 from mpm_warp.scenes.shear_test import shear_curves
 
-DEVICE = "cpu"
 G = 9.81
 
 

@@ -11,12 +11,12 @@ import math
 
 import numpy as np
 import pytest
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
 from mpm_warp.io import checkpoint_path_for, read_checkpoint
 from mpm_warp.stress import cauchy_stress, kirchhoff_stress
 
-DEVICE = "cpu"
 G = 9.81
 
 

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 import warp as wp
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp
 from mpm_warp.kernels.shape import stencil_func
@@ -47,9 +48,9 @@ def test_bspline_partition_of_unity_and_moments(precision):
     rng = np.random.default_rng(0)
     dx = 0.037
     x = rng.uniform(0.1, 1.0, size=(500, 3))
-    out = wp.zeros((500, 13), dtype=wp.float64, device="cpu")
-    wp.launch(_KERNELS[T], 500, inputs=[wp.array(x, dtype=vec3(T), device="cpu"), vec3(T)(0.0, 0.0, 0.0),
-                                         T(1.0 / dx), T(dx), out], device="cpu")
+    out = wp.zeros((500, 13), dtype=wp.float64, device=DEVICE)
+    wp.launch(_KERNELS[T], 500, inputs=[wp.array(x, dtype=vec3(T), device=DEVICE), vec3(T)(0.0, 0.0, 0.0),
+                                         T(1.0 / dx), T(dx), out], device=DEVICE)
     o = out.numpy()
     tol = 1e-5 if precision == "float32" else 1e-12
     np.testing.assert_allclose(o[:, 0], 1.0, atol=tol)
@@ -74,7 +75,7 @@ def test_affine_field_survives_p2g_g2p(precision):
     b = np.array([0.3, -0.2, 0.1])
     A = np.array([[0.1, 0.4, -0.2], [-0.3, 0.05, 0.2], [0.25, -0.1, -0.15]])
     sc = _free_scene(precision, velocity=lambda x: b + x @ A.T, dt=1e-7, E=1e-3)
-    sim = mpm_warp.Simulation(sc, device="cpu")
+    sim = mpm_warp.Simulation(sc, device=DEVICE)
     sim.state.C.assign(np.broadcast_to(A, (sim.model.n_particles, 3, 3)).copy())
     x_old = sim.state.x.numpy().astype(np.float64)
     sim.stepper.set_frame_end(1.0)
@@ -105,7 +106,7 @@ def test_momentum_conserved_without_walls_or_gravity():
         return np.array([0.2, -0.1, 0.05]) + np.cross([0.0, 0.0, 1.5], x - 0.5) + wobble
 
     sc = _free_scene("float64", velocity=vel, dt=2e-4, E=2e4)
-    sim = mpm_warp.Simulation(sc, device="cpu")
+    sim = mpm_warp.Simulation(sc, device=DEVICE)
     P0, L0 = _momenta(sim)
     sim.stepper.set_frame_end(1.0)
     sim.stepper.steps(200)
@@ -120,7 +121,7 @@ def test_free_fall_exact(precision):
     g = np.array([0.0, -9.81, 0.0])
     dt = 1e-3
     sc = _free_scene(precision, gravity=tuple(g), dt=dt)
-    sim = mpm_warp.Simulation(sc, device="cpu")
+    sim = mpm_warp.Simulation(sc, device=DEVICE)
     x0 = sim.state.x.numpy().astype(np.float64)
     n = 50
     sim.step_to(n * dt)
@@ -153,7 +154,7 @@ def test_rigid_spin_builds_no_stress():
         blocks=(mpm_warp.Block("m", (0.35, 0.3, 0.35), (0.65, 0.6, 0.45), velocity=vel),),
         precision="float32",
     )
-    sim = mpm_warp.Simulation(sc, device="cpu")
+    sim = mpm_warp.Simulation(sc, device=DEVICE)
     ke0 = sim.energies()["kinetic_energy"]
     sim.step_to(np.pi / 2 / omega)
     e = sim.energies()

@@ -12,11 +12,11 @@ from __future__ import annotations
 import math
 
 import pytest
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 from mpm_warp import InvalidArgument
 from mpm_warp.validation import PROBLEMS, axial_bar, self_weight_column, weak_layer_collapse
 
-DEVICE = "cpu"
 FIELDS = {"problem", "dx", "cfl", "dt", "error", "signed_error", "measured", "reference", "wall_time_s", "steps",
           "n_particles", "particle_steps_per_s", "device", "precision", "warp_version", "n_threads",
           "sim_time_s", "dt_mean_s", "details"}

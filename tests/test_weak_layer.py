@@ -84,6 +84,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
 from mpm_warp.materials import hardening_collapse
@@ -98,7 +99,6 @@ from mpm_warp.validation import (
     weak_layer_column,
 )
 
-DEVICE = "cpu"
 G = 9.81
 
 

@@ -1,0 +1,98 @@
+"""The one-command device suite runs end to end in its quick mode on the CPU (what a first GPU run relies on)."""
+
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+BENCH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks")
+sys.path.insert(0, BENCH)
+
+import device_suite  # noqa: E402
+import plastic_block as pb  # noqa: E402
+from taichi_peer import expected_com_y  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    out = tmp_path_factory.mktemp("suite")
+    proc = subprocess.run(["bash", os.path.join(BENCH, "device_suite.sh"), "--quick", "--device", "cpu",
+                           "--out", str(out)], capture_output=True, text=True, timeout=300,
+                          env=dict(os.environ, PYTHON=sys.executable))
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    with open(out / "device_suite_cpu_quick.json") as fh:
+        return json.load(fh), out
+
+
+def test_full_mode_is_budgeted_under_eight_minutes():
+    full = sum(b[0] for b in device_suite.BUDGETS.values())
+    assert full <= 450  # 30 s left for the interpreters' start-up within 8 min
+
+
+def test_every_part_ran_within_its_budget(quick):
+    res, _ = quick
+    env = res["environment"]
+    assert env["device"] == "cpu" and env["warp"] and env["date"] and len(env["load_average_1_5_15_min"]) == 3
+    assert set(res["parts"]) == set(device_suite.PARTS)
+    for name, part in res["parts"].items():
+        assert part["status"] == "ok", (name, part.get("output_tail"))
+        assert 0 < part["seconds"] <= part["budget_s"] == device_suite.BUDGETS[name][1]
+
+
+def test_device_tests_ran_and_passed(quick):
+    t = quick[0]["parts"]["tests"]["result"]
+    assert set(t["modules"]) == set(device_suite.QUICK_TEST_MODULES)
+    assert t["all_passed"] and t["tests"] >= 9 and t["failures"] == t["errors"] == 0
+
+
+def test_graph_replay_equals_eager_bit_for_bit(quick):
+    for name in ("graph", "graph_deterministic"):
+        g = quick[0]["parts"][name]["result"]
+        assert g["ok"] and g["bit_for_bit"] and g["expectation"] == "bit for bit"
+        assert g["steps"] == 6 + g["graph_batch"] and all(v == 0.0 for v in g["max_abs_difference"].values())
+
+
+def test_bytes_per_particle(quick):
+    rows = {(r["dim"], r["material"]): r for r in quick[0]["parts"]["memory"]["result"]["rows"]}
+    # float32: x, v (4 dim B each), C, H = F_E - I (4 dim^2 B each), in 2D h_zz (4 B); Cam-Clay adds log_Jp (4 B)
+    assert rows[(3, "elastic")]["particle_state_bytes_per_particle"] == 96.0
+    assert rows[(3, "plastic")]["particle_state_bytes_per_particle"] == 100.0
+    assert rows[(2, "elastic")]["particle_state_bytes_per_particle"] == 52.0
+    assert rows[(2, "plastic")]["particle_state_bytes_per_particle"] == 56.0
+    for (dim, _), r in rows.items():  # mass (4 B) and momentum (4 dim B) per node and grid copy
+        per_node = 4 + 4 * dim
+        assert r["grid_bytes_per_particle"] == pytest.approx(per_node * r["grid_nodes"] * r["grid_copies"]
+                                                             / r["n_particles"])
+
+
+def test_throughput_rows(quick):
+    res, out = quick
+    part = res["parts"]["throughput"]["result"]
+    assert os.path.exists(out / part["file"])
+    rows = part["rows"]
+    warp = {(r["dim"], r["material"]): r for r in rows if r["engine"] == "mpm_warp"}
+    assert set(warp) == {(d, m) for d in (2, 3) for m in ("elastic", "plastic")}
+    assert all(r["particle_steps_per_s"] > 0 for r in warp.values())
+    el = warp[(3, "elastic")]
+    # free fall of the block from rest: symplectic Euler, to float32 rounding of y ~ 0.5
+    assert el["com_y"] == pytest.approx(expected_com_y(el["warmup"] + el["steps"]), abs=1e-6)
+    pl = warp[(3, "plastic")]
+    assert pl["return_kind_problems"] == [] and len(pl["return_kinds"]) == pl["steps"]
+    assert min(k["yielded"] for k in pl["return_kinds"]) >= pb.MIN_YIELDED
+    taichi = {(r["dim"], r["material"]): r for r in rows if r["engine"] == "taichi"}
+    if importlib.util.find_spec("taichi") is None:
+        assert all("not installed" in r["error"] for r in taichi.values())
+        return
+    tp = taichi[(3, "plastic")]
+    assert tp["warmup"] == pl["warmup"] and tp["return_kind_problems"] == []
+    assert pb.agreement(pl["observables"], tp["observables"])["agree"]
+    assert taichi[(3, "elastic")]["com_y_after"] == pytest.approx(el["com_y"], abs=1e-6)
+
+
+def test_pst_ran(quick):
+    p = quick[0]["parts"]["pst"]["result"]
+    assert p["steps"] > 0 and p["n_particles"] > 0 and p["sim_time_s"] == pytest.approx(0.002, abs=1e-12)
+    assert p["edge_hits"] == 0 and p["particle_steps_per_s"] > 0
