@@ -43,8 +43,11 @@ Conversions:
   ``sigma_n`` once its bond cannot carry it): secant iteration in ``ln kappa_s``
   on the material-point shear test (:func:`~mpm_warp.scenes.weak_layer.paths.loaded_shear_test`)
   until it returns the given ``w_f`` or ``delta_s`` within :data:`CALIBRATION_RTOL`.
-  Start: ``delta = sqrt(2) D_wl kappa`` (pure plastic shear of the layer,
-  crack band = layer; Bazant and Oh 1983).
+  ``kappa_s`` is a plastic work per unit volume (J/m^3): the layer is debonded
+  once it has dissipated ``D_wl kappa_s`` per unit area, in shear, compaction or
+  any mix (crack band = layer; Bazant and Oh 1983;
+  :mod:`mpm_warp.kernels.bonded_camclay`). Start: ``D_wl kappa_s = 1.5 w_f``
+  (the softening work plus the residual's share), or ``tau_p delta_s``.
 
 Derived predictions for the scenes: the compressive (oedometric) strength, the
 collapse law at any final pressure, the residual strength and the bond left at
@@ -76,7 +79,7 @@ from .paths import (
 )
 
 __all__ = ["CalibratedWeakLayer", "weak_layer_material", "weac_collapse_height", "heierli_anticrack",
-           "CALIBRATION_RTOL"]
+           "shear_range", "CALIBRATION_RTOL"]
 
 CALIBRATION_RTOL = 1e-3
 """Relative tolerance of the ``kappa_s`` calibration on ``w_f`` or ``delta_s``."""
@@ -157,6 +160,12 @@ class CalibratedWeakLayer:
         d["material"] = self.material.to_dict()
         return d
 
+    @property
+    def debond_energy(self) -> float:
+        """Plastic work per unit area that debonds the layer, ``D_wl kappa_s`` (J/m^2), in shear, compaction or any
+        mix; ``w_f`` is the part of it above the residual friction in the shear test."""
+        return self.D_wl * self.kappa_s
+
     def describe(self) -> str:
         """Human-readable summary: inputs, derived parameters, predictions (printed by the scenes)."""
         m = self.material
@@ -173,8 +182,9 @@ class CalibratedWeakLayer:
             f"  softening slip   delta_s = {self.delta_s * 1e3:9.4g} mm    ({src.get('delta_s', 'predicted')})",
             f"  collapse height  h_c     = {self.h_c * 1e3:9.4g} mm    ({src.get('h_c', 'predicted')}; "
             f"{self.h_c / self.D_wl:.3g} of the layer)",
-            f"  -> p_bond = {self.p_bond:.5g} Pa, kappa_s = {self.kappa_s:.5g}, xi = {self.xi:.5g} "
-            f"(intact p0 = {m.p0_ini:.5g} Pa)",
+            f"  -> p_bond = {self.p_bond:.5g} Pa, kappa_s = {self.kappa_s:.5g} J/m^3, xi = {self.xi:.5g} "
+            f"(intact p0 = {m.p0_ini:.5g} Pa); debonded after {self.debond_energy:.3g} J/m^2 of plastic work, "
+            "in any mode",
             f"  predicted: compressive strength {self.compressive_strength:.4g} Pa "
             f"({self.compressive_strength / self.sigma_n:.3g} x sigma_n); shear-test peak {self.tau_peak:.4g} Pa, "
             f"residual {self.tau_residual:.3g} Pa; collapse removes the last {self.bond_at_collapse:.2f} of the bond",
@@ -196,9 +206,15 @@ def _exactly_one(a_name, a, b_name, b):
         raise InvalidArgument(f"{a_name}/{b_name}", (a, b), f"exactly one of {a_name} and {b_name}")
 
 
-def _measure(mat, sigma_n, D_wl, n):
+def shear_range(mat, sigma_n: float, tau: float) -> float:
+    """Shear strain (-) a loaded shear test of ``mat`` under ``sigma_n`` (Pa) needs to break the bond: the elastic
+    range plus twice the plastic shear that does the debonding work ``kappa_s`` at the shear stress ``tau`` (Pa)."""
+    return 1.5 * (sigma_n + mat.p0_ini) / mat.mu + 2.0 * mat.kappa_s / tau
+
+
+def _measure(mat, sigma_n, D_wl, n, tau):
     """Shear test run long enough for the bond to go (doubling the shear range)."""
-    gamma_end = 1.5 * (sigma_n + mat.p0_ini) / mat.mu + 2.0 * math.sqrt(2.0) * mat.kappa_s
+    gamma_end = shear_range(mat, sigma_n, tau)
     for _ in range(8):
         r = loaded_shear_test(mat, sigma_n, D_wl, gamma_end, n, device="cpu")  # deterministic on any machine
         if r["lost"] and r["loss_index"] < 0.9 * n:
@@ -309,7 +325,7 @@ def weak_layer_material(*, E: float, nu: float, density: float, D_wl: float, M: 
     else:
         given["p_bond"] = f("p_bond", p_bond, lo=0.0)
     mat0 = BondedCamClay(E, nu, density, M=M, beta=beta, xi=xi, p0_int_ini=p0_int_ini, p0_floor_ratio=p0_floor_ratio,
-                         p_bond=p_bond, kappa_s=1.0)
+                         p_bond=p_bond, kappa_s=math.inf)
     sigma_c = compressive_strength(mat0)
     if sigma_c <= sigma_n:
         raise InvalidArgument("tau_p" if "tau_p" in given else "p_bond", tau_p if "tau_p" in given else p_bond,
@@ -325,21 +341,21 @@ def weak_layer_material(*, E: float, nu: float, density: float, D_wl: float, M: 
                                          f"{sigma_n:.4g} Pa (here it yields in compaction: tau_p = {tau_first:.4g} Pa, "
                                          f"oedometric strength {sigma_c:.4g} Pa); raise it")
 
-    # fracture energy or softening slip -> kappa_s (secant in ln kappa_s on the shear test). Start: the plastic
-    # slip sqrt(2) D_wl kappa_s of pure shear, of which the collapse cuts off the last ~40 %, at a mean shear
-    # stress of ~0.6 tau_p
+    # fracture energy or softening slip -> kappa_s (secant in ln kappa_s on the shear test). Start: the debonding
+    # work per unit area D_wl kappa_s is the softening work w_f plus the residual's share (~1.5 w_f), or the peak
+    # stress on the softening slip
     if w_f is not None:
         target, key = f("w_f", w_f, lo=0.0, lo_open=True), "w_f"
-        k = target / (0.6 * tau_first * 0.6 * math.sqrt(2.0) * D_wl)
+        k = 1.5 * target / D_wl
     else:
         target, key = f("delta_s", delta_s, lo=0.0, lo_open=True), "delta_s"
-        k = target / (0.6 * math.sqrt(2.0) * D_wl)
+        k = tau_first * target / D_wl
     given[key] = target
     n = _CALIBRATION_INCREMENTS
     hist, runs = [], []
     while True:
         mat = replace(mat0, kappa_s=k)
-        r = _measure(mat, sigma_n, D_wl, n)
+        r = _measure(mat, sigma_n, D_wl, n, tau_first)
         if not r[key] > 0.0:
             raise InvalidArgument(key, target, f"a value the shear test can reach (it gives {r[key]:.4g})")
         err = math.log(r[key] / target)
