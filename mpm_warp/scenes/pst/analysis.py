@@ -71,7 +71,8 @@ def pst_summary(params: PSTParams, times, series: dict, s_bins, t_damage, t_defl
         over :data:`MEAN_SPEED_DISTANCE`, nan if not reached), ``speed_max`` (m/s, the largest local
         speed within :data:`SPEED_LIMIT_DISTANCE`), ``speed_profile`` (local speeds over
         :data:`SPEED_WINDOW` windows), ``path``. Then ``propagated`` (the damage front ran at least
-        2 m, or to within 2 bins of the end, beyond the cut), ``ran_to_end``, ``speed`` (the damage
+        2 m beyond the cut, or to the end zone: within one slab thickness of the far end, whose free edge
+        unloads the layer under it), ``ran_to_end`` (into the end zone), ``speed`` (the damage
         front's mean speed), ``front_agreement`` (deflection over damage mean speed), ``runaway_cut``
         (m: the saw position when the crack ran away from it, the one-run estimate of the critical
         cut), ``max_damage_lead``/``max_damage_lead_at`` (m: how far ahead of the contiguous front a
@@ -86,8 +87,9 @@ def pst_summary(params: PSTParams, times, series: dict, s_bins, t_damage, t_defl
     out.update(_front(params, s_bins, t_damage, "damage"))
     out.update(_front(params, s_bins, t_deflection, "deflection"))
     reach = out["damage_front_final"]
-    out["propagated"] = bool(reach >= min(cut + 2.0, L - 2.0 * bin_w))
-    out["ran_to_end"] = bool(reach >= L - 2.0 * bin_w)
+    end_zone = max(float(params.slab_thickness), 2.0 * bin_w)   # the free far end unloads the layer under it
+    out["propagated"] = bool(reach >= min(cut + 2.0, L - end_zone))
+    out["ran_to_end"] = bool(reach >= L - end_zone)
     out["speed"] = out["damage_speed_mean"]
     v1, v2 = out["damage_speed_mean"], out["deflection_speed_mean"]
     out["front_agreement"] = v2 / v1 if np.isfinite(v1) and np.isfinite(v2) and v1 > 0 else math.nan

@@ -86,8 +86,8 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
     tol : float
         Bracket width to stop at (m).
     run_distance : float
-        A trial propagated once its damage front ran this far beyond its cut (m), or to within two
-        bins of the column's end.
+        A trial propagated once its damage front ran this far beyond its cut (m), or into the end zone
+        (within one slab thickness of the far end, as :func:`~.analysis.pst_summary`).
     free_run : float
         A trial arrested if it has not propagated this long after its saw stopped (s).
     snapshot_every : float, optional
@@ -152,7 +152,7 @@ def _trial(sim: Simulation, mon: PSTMonitor, cut: float, run_distance: float, fr
            check_interval: float) -> dict:
     """Run a trial from where ``sim`` is until its crack propagated or arrested."""
     p = mon.params
-    goal = min(cut + run_distance, p.length - 2.0 * p.bin_width)
+    goal = min(cut + run_distance, p.length - max(p.slab_thickness, 2.0 * p.bin_width))   # the end zone as pst_summary
     t_stop = p.saw_start + cut / p.saw.speed + free_run
     t = sim.time
     front = 0.0

@@ -75,7 +75,8 @@ class PSTParams:
     slab_thickness : float
         Slab thickness D (m), > 0.
     weak_layer_thickness : float
-        D_wl (m), at least 2 grid cells (the B-spline stencil of the slab must not reach the substratum).
+        D_wl (m), at least 3 grid cells (:data:`~mpm_warp.scenes.snow.MIN_WEAK_LAYER_CELLS`: the B-spline
+        stencils of the slab and the substratum must not share a node); 4 resolve it (the default).
     substratum_thickness : float
         Elastic old snow under the weak layer (m), >= 2 dx: the layer shares no grid node with the bed.
     slope_angle : float
@@ -97,11 +98,11 @@ class PSTParams:
     """
 
     kind: ClassVar[str] = "pst"
-    dx: float = 0.005
+    dx: float = 0.0075
     particles_per_cell: int = 2
     length: float = 8.0
     slab_thickness: float = 0.5
-    weak_layer_thickness: float = 0.02
+    weak_layer_thickness: float = 0.03
     substratum_thickness: float = 0.15
     slope_angle: float = 0.0
     width: float = 0.0

@@ -26,13 +26,14 @@ __all__ = ["WeakLayer"]
 class WeakLayer:
     """The weak layer in field quantities (SI units; see the module docstring).
 
-    Defaults: the layer of Gaume et al. (2018)'s experiment 2 as far as published, completed from
-    the field literature: a 2 cm layer of density 150 (E 1 MPa: 0.93 rho^2.8 capped at the field
+    Defaults: a persistent weak layer of density 150 (E 1 MPa: 0.93 rho^2.8 capped at the field
     range 0.05-1 MPa; nu 0.3), M 1.2 (a 30 deg friction angle), beta 0.3; shear strength 1 kPa
-    under a 0.5 m slab (Jamieson and Johnston 2001: 0.5-2 kPa for persistent weak layers); the
-    softening slip 2 mm of SI Note 2 (McClung 1977; 3.5 mm in Bazant et al. 2003), which with this
-    strength costs about 1.4 J/m^2 (field 0.1-1.7 J/m^2: van Herwijnen et al. 2016; Bergfeld et
-    al. 2021, 2023); collapse height from the WEAC fit (4.3 mm for 2 cm).
+    under a 0.5 m slab (Jamieson and Johnston 2001: 0.5-2 kPa for persistent weak layers); fracture
+    energy 0.79 J/m^2, the mode-II toughness G_IIc of Weissgraeber and Rosendahl (2023), WEAC's
+    default (field 0.1-1.7 J/m^2: van Herwijnen et al. 2016; Bergfeld et al. 2021, 2023); with this
+    strength it softens over ~1.2 mm of slip (SI Note 2's experiment: ~2 mm; McClung 1977; 3.5 mm
+    in Bazant et al. 2003); collapse height from the WEAC fit (4.6 mm for 3 cm). The layer's
+    debonding work is the same in compaction (:mod:`mpm_warp.kernels.bonded_camclay`).
 
     Attributes
     ----------
@@ -65,8 +66,8 @@ class WeakLayer:
     beta: float = 0.3
     tau_p: float = 1000.0
     p_bond: float = 0.0
-    w_f: float = 0.0
-    delta_s: float = 2.0e-3
+    w_f: float = 0.79
+    delta_s: float = 0.0
     h_c: float = 0.0
     xi: float = 0.0
     p0_int_ini: float = 0.0
