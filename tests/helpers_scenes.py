@@ -8,3 +8,13 @@ weak layer, the minimum), settled by 0.04 s, the saw cutting at 1 m/s from then 
 TINY_PST = ["scene.length=0.6", "scene.slab_thickness=0.15", "scene.dx=0.01", "scene.weak_layer_thickness=0.03",
             "scene.substratum_thickness=0.03", "scene.margin=0.03", "scene.saw.cut_length=0.15",
             "scene.settle.gravity_ramp=0.02", "scene.settle.duration=0.04", "time.frame_interval=0.005"]
+
+
+def assert_same_series(a: dict, b: dict) -> None:
+    """Two monitors' frame series are the same, bit for bit (NaN where the other has NaN: touchdown before the
+    crack runs)."""
+    import numpy as np
+
+    assert a.keys() == b.keys()
+    for k in a:
+        np.testing.assert_array_equal(np.asarray(a[k], dtype=float), np.asarray(b[k], dtype=float), err_msg=k)

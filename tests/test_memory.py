@@ -45,7 +45,7 @@ SCENES = {
     "block-float64-2-threads": lambda: (mw.load_scenario("elastic_block", ['precision="float64"']), 2),
     "plane-strain-float32": lambda: (_plane_block("float32"), 1),
     "plane-strain-float64-camclay": lambda: (_plane_block("float64"), 2),
-    "pst-bonded-yielded": lambda: (mw.load_scenario("pst_demo", PST), 1),
+    "bonded-pst-yielded": lambda: (mw.load_scenario("pst_demo", PST), 1),
     "bonded-3d-float32-2-threads": lambda: (_bonded_layer(3, "float32"), 2),
     "bonded-2d-float64": lambda: (_bonded_layer(2, "float64"), 1),
 }

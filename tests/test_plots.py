@@ -127,8 +127,9 @@ def test_pst_series_names_and_fit_window(tmp_path):
     assert names == ["front.png", "front.csv", "front.json", "markers.png", "markers.csv"]
     fit = json.loads((tmp_path / "front.json").read_text())
     assert fit["series"] == "front" and fit["speed"] == pytest.approx(C, rel=1e-9)
-    # the positions of the PST's own mean speed: from the cut over 3 m, at most to two bins before the end
-    assert fit["window"] == pytest.approx([CUT, min(CUT + 3.0, END - 2 * PSTParams().bin_width)])
+    # the positions of the PST's own mean speed: from a bin beyond the cut over 3 m, at most to the end zone
+    bw = PSTParams().bin_width
+    assert fit["window"] == pytest.approx([CUT + bw, min(CUT + 3.0, END - max(PSTParams().slab_thickness, 2 * bw))])
     front = read_csv(tmp_path / "front.csv")
     assert list(front) == ["time [s]", "front [m]", "deflection_front [m]", "saw [m]", "front_fit [m]"]
     markers = read_csv(tmp_path / "markers.csv")

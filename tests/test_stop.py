@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 import pytest
-from helpers_scenes import TINY_PST
+from helpers_scenes import TINY_PST, assert_same_series
 
 import mpm_warp as mw
 from mpm_warp import io
@@ -81,7 +81,8 @@ def test_pst_stopped_mid_frame_while_sawing_resumes_bit_for_bit(tmp_path):
     """A PST stopped half-way through a frame after settling (the saw cutting, yielded flags half collected)."""
     overrides = TINY_PST + ["time.end=0.065", "output.checkpoint_every=4", 'output.fields=["x", "log_jp", "yielded"]']
     full, res = _stopped_mid_frame_then_resumed(tmp_path, "pst_demo", overrides, lambda s: s.time > 0.0525)
-    assert full.monitor.series == res.monitor.series and full.scene_result.keys() == res.scene_result.keys()
+    assert_same_series(full.monitor.series, res.monitor.series)
+    assert full.scene_result.keys() == res.scene_result.keys()
     for k in full.scene_result:
         np.testing.assert_array_equal(np.asarray(full.scene_result[k]), np.asarray(res.scene_result[k]))
     assert mw.read_run(str(tmp_path / "part.h5")).field("yielded").any()

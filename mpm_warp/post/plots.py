@@ -25,7 +25,9 @@ import re
 import numpy as np
 
 from ..io import RunData, read_run
-from .fronts import front_name, front_speed
+from ..scenes.pst import PSTParams
+from .fronts import front_name, front_speed, scene_params
+from .pst_picture import pst_picture
 
 __all__ = ["plot_run", "plot_front", "plot_markers", "plot_shear", "plot_energy"]
 
@@ -185,7 +187,9 @@ def plot_run(path, out_dir=None) -> list[str]:
     list of str
         ``front.*`` (with ``front_position`` or ``front``), ``markers.*`` (with ``marker_<k>_dx|dy`` or
         ``marker<k>_ux|uy``),
-        ``shear.*`` (with ``shear_strain``), ``energy.*`` (with ``*_energy`` series), in that order.
+        ``shear.*`` (with ``shear_strain``), ``energy.*`` (with ``*_energy`` series), ``pst.png`` (a PST run
+        with ``x``, ``log_jp`` and ``log_jp_ref``: :func:`mpm_warp.post.pst_picture.pst_picture` at the moment
+        the crack runs), in that order.
     """
     run = path if isinstance(path, RunData) else read_run(path)
     out_dir = os.fspath(out_dir) if out_dir is not None else os.path.splitext(run.path)[0] + "_plots"
@@ -199,4 +203,6 @@ def plot_run(path, out_dir=None) -> list[str]:
         files += plot_shear(run, out_dir)
     if any(n.endswith("_energy") for n in s):
         files += plot_energy(run, out_dir)
+    if isinstance(scene_params(run), PSTParams) and {"x", "log_jp", "log_jp_ref"} <= set(run.particle_fields):
+        files.append(pst_picture(run, os.path.join(out_dir, "pst.png")))
     return files

@@ -15,7 +15,7 @@ from ..fronts import front_trajectory, lead_ahead_of_front, mean_speed, speed_pr
 from ..references import heierli_speed, heierli_touchdown
 from .params import PSTParams
 
-__all__ = ["pst_summary", "SPEED_WINDOW", "MEAN_SPEED_DISTANCE", "SPEED_LIMIT_DISTANCE"]
+__all__ = ["pst_summary", "end_zone", "SPEED_WINDOW", "MEAN_SPEED_DISTANCE", "SPEED_LIMIT_DISTANCE"]
 
 #: window of the local front speed (m)
 SPEED_WINDOW = 0.5
@@ -25,12 +25,17 @@ MEAN_SPEED_DISTANCE = 3.0
 SPEED_LIMIT_DISTANCE = 5.0
 
 
+def end_zone(params: PSTParams) -> float:
+    """Length of the far end zone (m): one slab thickness (at least two bins), whose free edge unloads the layer."""
+    return max(float(params.slab_thickness), 2.0 * params.bin_width)
+
+
 def _front(params: PSTParams, s, t_arrival, prefix: str) -> dict:
     cut, L = float(params.saw.cut_length), float(params.length)
     sp, T = front_trajectory(s, t_arrival)
     reach = float(sp[-1] + 0.5 * params.bin_width) if len(sp) else 0.0
     mids, c = speed_profile(sp, T, SPEED_WINDOW, start=cut)
-    d1 = min(cut + MEAN_SPEED_DISTANCE, L - 2.0 * params.bin_width)
+    d1 = min(cut + MEAN_SPEED_DISTANCE, L - end_zone(params))
     within = mids <= cut + SPEED_LIMIT_DISTANCE
     return {f"{prefix}_front_final": min(reach, L),
             f"{prefix}_speed_mean": mean_speed(sp, T, cut, d1),
@@ -68,8 +73,9 @@ def pst_summary(params: PSTParams, times, series: dict, s_bins, t_damage, t_defl
     -------
     dict
         Per front (``damage_``/``deflection_``): ``front_final`` (m), ``speed_mean`` (m/s, from the cut
-        over :data:`MEAN_SPEED_DISTANCE`, nan if not reached), ``speed_max`` (m/s, the largest local
-        speed within :data:`SPEED_LIMIT_DISTANCE`), ``speed_profile`` (local speeds over
+        over :data:`MEAN_SPEED_DISTANCE` or to the end zone (:func:`end_zone`), nan if not reached),
+        ``speed_max`` (m/s, the largest local speed within :data:`SPEED_LIMIT_DISTANCE`), ``speed_profile`` (local
+        speeds over
         :data:`SPEED_WINDOW` windows), ``path``. Then ``propagated`` (the damage front ran at least
         2 m beyond the cut, or to the end zone: within one slab thickness of the far end, whose free edge
         unloads the layer under it), ``ran_to_end`` (into the end zone), ``speed`` (the damage
@@ -82,14 +88,13 @@ def pst_summary(params: PSTParams, times, series: dict, s_bins, t_damage, t_defl
         :meth:`PSTParams.references` (with ``heierli_speed_run``/``heierli_touchdown_run``: Heierli's
         values with the run's own collapse height).
     """
-    cut, L, bin_w = float(params.saw.cut_length), float(params.length), params.bin_width
+    cut, L = float(params.saw.cut_length), float(params.length)
     out = {"cut_length": cut, "column_length": L}
     out.update(_front(params, s_bins, t_damage, "damage"))
     out.update(_front(params, s_bins, t_deflection, "deflection"))
     reach = out["damage_front_final"]
-    end_zone = max(float(params.slab_thickness), 2.0 * bin_w)   # the free far end unloads the layer under it
-    out["propagated"] = bool(reach >= min(cut + 2.0, L - end_zone))
-    out["ran_to_end"] = bool(reach >= L - end_zone)
+    out["propagated"] = bool(reach >= min(cut + 2.0, L - end_zone(params)))
+    out["ran_to_end"] = bool(reach >= L - end_zone(params))
     out["speed"] = out["damage_speed_mean"]
     v1, v2 = out["damage_speed_mean"], out["deflection_speed_mean"]
     out["front_agreement"] = v2 / v1 if np.isfinite(v1) and np.isfinite(v2) and v1 > 0 else math.nan

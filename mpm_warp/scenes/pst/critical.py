@@ -21,6 +21,7 @@ import time as _time
 
 from ...simulation import Simulation
 from ..fronts import bisect_threshold
+from .analysis import end_zone
 from .monitor import PSTMonitor, attach
 from .params import PSTParams
 
@@ -46,6 +47,10 @@ class CriticalCut:
         The base run's :func:`~.analysis.pst_summary` (cut ``hi`` of the first call).
     wall : float
         Wall time of the whole search (s).
+    bracketed : bool
+        False when a cut of ``lo`` propagated or one of ``hi`` arrested: ``value`` is nan and ``note``
+        says which (the trials are kept).
+    note : str
     """
 
     value: float
@@ -55,6 +60,8 @@ class CriticalCut:
     runaway_cut: float
     base: dict
     wall: float
+    bracketed: bool = True
+    note: str = ""
 
     def to_dict(self) -> dict:
         """Plain dict (JSON)."""
@@ -73,7 +80,8 @@ def _simulation(scenario, device, n_threads) -> tuple[Simulation, PSTMonitor]:
 
 def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance: float = 1.0,
                  free_run: float = 0.2, snapshot_every: float | None = None, check_interval: float = 0.01,
-                 device: str | None = None, n_threads: int | None = None, log=None) -> CriticalCut:
+                 base_run_distance: float | None = None, device: str | None = None, n_threads: int | None = None,
+                 log=None) -> CriticalCut:
     """Bisect the critical cut of the PST ``scenario`` within ``[lo, hi]`` (m) to ``tol`` (m).
 
     Parameters
@@ -81,8 +89,8 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
     scenario : Scenario
         A PST scenario (``scenario.scene`` a :class:`PSTParams`); its own cut length is ignored.
     lo, hi : float
-        Bracket (m): a cut of ``lo`` must arrest and one of ``hi`` propagate (both are run; a
-        ValueError names the end that does not).
+        Bracket (m): a cut of ``lo`` should arrest and one of ``hi`` propagate (both are run; when
+        not, the result is not ``bracketed`` and its ``note`` names the end).
     tol : float
         Bracket width to stop at (m).
     run_distance : float
@@ -92,6 +100,10 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         A trial arrested if it has not propagated this long after its saw stopped (s).
     snapshot_every : float, optional
         Blade travel between snapshots of the base run (m); default ``tol / 2``.
+    base_run_distance : float, optional
+        How far beyond ``hi`` the base run's crack must run before it stops (m); default
+        ``run_distance``; ``length`` runs it into the end zone, so that its ``base`` summary holds the
+        crack's speed over the column.
     check_interval : float
         Simulated time between the trial's front checks (s).
     device, n_threads
@@ -120,7 +132,8 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
             break
         a = min(a + step, hi)
         sim.step_to(t_saw + a / v)
-    base = _trial(sim, mon, hi, run_distance, free_run, check_interval)
+    base = _trial(sim, mon, hi, run_distance if base_run_distance is None else base_run_distance, free_run,
+                  check_interval)
     base_summary = mon.result()
     trials = [{**base, "wall": _time.perf_counter() - wall0}]
     if log:
@@ -143,16 +156,21 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
                 f"({out['wall']:.0f} s)")
         return out["propagated"]
 
-    b = bisect_threshold(propagates, lo, hi, tol)
-    return CriticalCut(b.value, b.lo, b.hi, trials, float(base_summary.get("runaway_cut", math.nan)),
-                       base_summary, _time.perf_counter() - wall0)
+    runaway = float(base_summary.get("runaway_cut", math.nan))
+    low = propagates(lo)
+    if low or not cache[hi]:   # the critical cut is not in the bracket: say which end, keep the trials
+        why = f"a cut of {lo:g} m propagated" if low else f"a cut of {hi:g} m arrested"
+        return CriticalCut(math.nan, lo, hi, trials, runaway, base_summary, _time.perf_counter() - wall0,
+                           bracketed=False, note=why)
+    b = bisect_threshold(propagates, lo, hi, tol, check_ends=False)
+    return CriticalCut(b.value, b.lo, b.hi, trials, runaway, base_summary, _time.perf_counter() - wall0)
 
 
 def _trial(sim: Simulation, mon: PSTMonitor, cut: float, run_distance: float, free_run: float,
            check_interval: float) -> dict:
     """Run a trial from where ``sim`` is until its crack propagated or arrested."""
     p = mon.params
-    goal = min(cut + run_distance, p.length - max(p.slab_thickness, 2.0 * p.bin_width))   # the end zone as pst_summary
+    goal = min(cut + run_distance, p.length - end_zone(p))
     t_stop = p.saw_start + cut / p.saw.speed + free_run
     t = sim.time
     front = 0.0
