@@ -109,6 +109,10 @@ def main(argv=None) -> int:
     ap.add_argument("--name", default=None, help="result name (default: the scenario's name)")
     ap.add_argument("--h5dir", default=os.environ.get("TMPDIR", "/tmp"), help="folder of the run file")
     ap.add_argument("--device", default="cpu")
+    ap.add_argument("--resume", action="store_true",
+                    help="continue an interrupted run of this scene in --h5dir from its checkpoint")
+    ap.add_argument("--prior-wall-s", type=float, default=0.0,
+                    help="with --resume: wall seconds the interrupted part ran (added to the reported wall time)")
     a = ap.parse_args(argv)
     sc = mw.load_scenario(a.scene, a.overrides)
     name = a.name or sc.name
@@ -116,12 +120,16 @@ def main(argv=None) -> int:
     h5 = os.path.join(a.h5dir, f"snow_{name}.h5")
     print(sc.scene.calibrated().describe(), flush=True)
     t0 = time.perf_counter()
-    rr = mw.run(sc, h5, device=a.device, overwrite=True)
-    wall = time.perf_counter() - t0
+    if a.resume:
+        rr = mw.resume(h5, device=a.device)
+    else:
+        rr = mw.run(sc, h5, device=a.device, overwrite=True)
+    wall = time.perf_counter() - t0 + a.prior_wall_s
     mon = rr.monitor
     keep = ("front", "deflection_front", "saw", "collapse_height", "touchdown")
     res = {"name": name, "scenario": a.scene, "overrides": a.overrides, "description": sc.description,
-           "environment": environment(a.device), "wall_s": wall, "steps": rr.steps, "particles": rr.n_particles,
+           "environment": environment(a.device), "wall_s": wall,
+           "resumed": bool(a.resume), "steps": rr.steps, "particles": rr.n_particles,
            "particle_steps_per_s": rr.particle_steps_per_s, "h5": h5,
            "weak_layer": sc.scene.calibrated().to_dict(),
            "result": rr.scene_result, "times": list(mon.times),

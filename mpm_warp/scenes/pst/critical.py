@@ -80,8 +80,8 @@ def _simulation(scenario, device, n_threads) -> tuple[Simulation, PSTMonitor]:
 
 def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance: float = 1.0,
                  free_run: float = 0.2, snapshot_every: float | None = None, check_interval: float = 0.01,
-                 base_run_distance: float | None = None, device: str | None = None, n_threads: int | None = None,
-                 log=None) -> CriticalCut:
+                 base_run_distance: float | None = None, base_free_run: float | None = None,
+                 device: str | None = None, n_threads: int | None = None, log=None) -> CriticalCut:
     """Bisect the critical cut of the PST ``scenario`` within ``[lo, hi]`` (m) to ``tol`` (m).
 
     Parameters
@@ -104,8 +104,11 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         How far beyond ``hi`` the base run's crack must run before it stops (m); default
         ``run_distance``; ``length`` runs it into the end zone, so that its ``base`` summary holds the
         crack's speed over the column.
+    base_free_run : float, optional
+        The base run's ``free_run`` (s); default ``free_run``.
     check_interval : float
-        Simulated time between the trial's front checks (s).
+        Simulated time between the trial's front checks (s); each is a frame of the monitor's series, so
+        the ``base`` summary has a touchdown and a collapse height.
     device, n_threads
         As :class:`~mpm_warp.Simulation`.
     log : callable, optional
@@ -132,8 +135,8 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
             break
         a = min(a + step, hi)
         sim.step_to(t_saw + a / v)
-    base = _trial(sim, mon, hi, run_distance if base_run_distance is None else base_run_distance, free_run,
-                  check_interval)
+    base = _trial(sim, mon, hi, run_distance if base_run_distance is None else base_run_distance,
+                  free_run if base_free_run is None else base_free_run, check_interval)
     base_summary = mon.result()
     trials = [{**base, "wall": _time.perf_counter() - wall0}]
     if log:
@@ -177,6 +180,7 @@ def _trial(sim: Simulation, mon: PSTMonitor, cut: float, run_distance: float, fr
     while t < t_stop - 1e-12:
         t = min(t + check_interval, t_stop)
         sim.step_to(t)
+        mon.frame_scalars(sim)          # a frame of the monitor's series (touchdown, collapse height)
         front = mon.damage_front(t)
         if front >= goal:
             break
