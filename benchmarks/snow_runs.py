@@ -70,7 +70,7 @@ def pst_case(name: str, scene: str, h5dir: str, device: str, overrides=None) -> 
     """Run one PST scene, write its JSON and figure, return the results."""
     path = os.path.join(h5dir, f"{name}.h5")
     t0 = time.perf_counter()
-    res = mw.run(scene, output=path, device=device, overrides=overrides)
+    res = mw.run(scene, output=path, device=device, overrides=overrides, overwrite=True)   # --h5dir may be reused
     mon = res.monitor
     elapsed = time.perf_counter() - t0
     ex = dict(res.scene_result)
@@ -161,7 +161,7 @@ def shear_case(h5dir: str, device: str, overrides=None) -> dict:
     """Run the shear test, write its JSON and figure."""
     path = os.path.join(h5dir, "shear_test.h5")
     t0 = time.perf_counter()
-    res = mw.run("shear_test", output=path, device=device, overrides=overrides)
+    res = mw.run("shear_test", output=path, device=device, overrides=overrides, overwrite=True)
     mon = res.monitor
     elapsed = time.perf_counter() - t0
     series = {k: np.asarray(v) for k, v in mon.series.items()}

@@ -52,7 +52,7 @@ def slope_gravity(theta_deg: float) -> list[float]:
 
 def proxy_runner(scenario, output, device):
     """Run the block and add its release speed and acceleration (m/s, m/s^2) to ``scene_result``."""
-    res = mw.run(scenario, output, device)
+    res = mw.run(scenario, output, device, overwrite=True)      # a dead worker may have left its .part.h5
     data = mw.read_run(output)
     vx = np.array([data.frame(i)["v"][:, 0].mean() for i in range(data.n_frames)], dtype=float)
     late = data.times >= data.times[-1] / 4

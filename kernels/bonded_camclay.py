@@ -4,7 +4,7 @@ The weak layer of a snowpack is strong while its bonds hold and collapses once
 they break (Gaume et al. 2018: "cohesion loss coupled with volumetric
 collapse"). Gaume's Cam-Clay (:mod:`mpm_warp.kernels.camclay`) has one
 hardening variable and cannot do both (MODEL.md 3b), so the weak layer carries
-a bonded part in its yield ellipse that decays with plastic strain, as in
+a bonded part in its yield ellipse that decays with the plastic work done, as in
 structured / destructuring Cam-Clay (Rouainia and Muir Wood 2000; Liu and
 Carter 2002). Stresses are Kirchhoff (Pa), compression positive (MODEL.md 1):
 
@@ -14,33 +14,42 @@ Carter 2002). Stresses are Kirchhoff (Pa), compression positive (MODEL.md 1):
     p0_int   = max(K sinh(xi max(-log_Jp, 0)), p0_floor)          (intrinsic: camclay_p0)
     b        = max(0, 1 - kappa / kappa_s)                        (bond, 1 intact, 0 gone)
 
-State per particle: ``log_Jp = ln det F_P`` (as camclay) and ``kappa`` (-),
-the accumulated plastic strain
+State per particle: ``log_Jp = ln det F_P`` (as camclay) and ``kappa`` (J/m^3),
+the plastic work the layer has done per unit volume,
 
-    kappa += |eps_tr - eps_new| = sqrt(|dev d|^2 + tr(d)^2 / 3),   d = eps_tr - eps_new,
+    kappa += tau_new : d = p_new (p_tr - p_new)/K + sqrt(2/3) q_new |dev d|,   d = eps_tr - eps_new,
 
-the Euclidean norm of the principal plastic Hencky strain increment that the
-return gives. Why this measure: both parts count, since bonds break in shear
-and in compaction (the "damage strain" of Rouainia and Muir Wood 2000, here
-with equal weights: no extra parameter); it is invariant (isotropic in the
-principal strains); and in plastic simple shear ``|d| = gamma_p / sqrt(2)``, so
-a plastic slip ``delta`` across a layer of thickness ``D`` gives ``kappa = delta
-/ (sqrt(2) D)``. The bond is linear in ``kappa`` (Rouainia and Muir Wood use an
-exponential decay) so that it ends at a finite slip, as the linear softening
-of a cohesive crack (Bazant and Oh 1983), and its fracture energy scales with
-``kappa_s``.
+the work of the returned (new) Kirchhoff stress on the principal plastic Hencky
+strain increment of the return. Why this measure: a bond costs the same energy
+however it breaks. Bonds break in shear and in compaction; a weak layer's
+measured toughnesses in the two modes are of one order (G_Ic = 0.56 and G_IIc
+= 0.79 J/m^2, Weissgraeber and Rosendahl 2023, WEAC), and in a PST the layer
+at the crack tip fails mostly in compaction under the bending slab. The
+plastic strain norm (the "damage strain" of Rouainia and Muir Wood 2000, an
+earlier version of this module) makes compaction about twice as costly as
+shear for the same bond loss (a PST's compacting process zone then dissipated
+~5 J/m^2 against 1.4 in shear; measured on the PST scene); the work makes the
+energy to debond one number, ``kappa_s D_wl`` per unit area, in every mode. It
+is invariant and non-negative: with the associative flow the work of the new
+stress on ``d`` is ``dgamma (p y_p + q y_q) >= -dgamma y(0) >= 0`` (the origin
+lies inside the ellipse); round-off below zero is cut. In plastic simple shear
+it is ``tau gamma_p``: the shear stress times the plastic slip over the
+thickness. The bond is linear in ``kappa`` (Rouainia and Muir Wood use an
+exponential decay) so that it ends at a finite work, as the linear softening
+of a cohesive crack (Bazant and Oh 1983).
 
 Regularisation (crack band, Bazant and Oh 1983). ``kappa`` is meant to be the
 mean over the layer thickness at one bed position: after every step the
 engine replaces the ``kappa`` of each weak-layer particle by the mean of its
 lattice column (:func:`kappa_column_sum_kernel`, :func:`kappa_column_mean_kernel`).
-The bond then lives on the layer's total plastic slip, ``b = 1 - delta /
-delta_s`` with ``delta_s = sqrt(2) D kappa_s``, however many cells span the
-layer and however the strain localises inside it, so the energy per unit
-crack area does not depend on dx (the band is the layer). Within a step a
-particle's return sees its own increment; the mean comes after the step (a
-difference of the order of one step's increment). ``kappa_s`` from a fracture
-energy or a softening displacement: :mod:`mpm_warp.weak_layer`.
+The bond then lives on the work done on the whole thickness per unit area,
+``D_wl kappa`` (J/m^2): the layer is debonded once it has dissipated ``D_wl
+kappa_s``, however many cells span it and however the strain localises inside
+it, so the energy per unit crack area does not depend on dx (the band is the
+layer). Within a step a particle's return sees its own increment; the mean
+comes after the step (a difference of the order of one step's increment).
+``kappa_s`` from a fracture energy or a softening displacement:
+:mod:`mpm_warp.scenes.weak_layer.calibration`.
 
 Return mapping (MODEL.md 4, SI Note 1), fully implicit. The discrete flow rule
 ``eps_tr - eps_new = dgamma dy/dtau`` is solved with the surface of the *new*
@@ -62,19 +71,21 @@ closest-point solver:
   ``(1 - beta)/2 xi cosh(xi x) > 1`` on the dry side: several roots), doubling
   steps walk to the sign change nearest the start instead;
 * bond: ``f(kappa) = kappa - kappa_n - dkappa(kappa) = 0`` with the volumetric
-  problem solved inside; ``dkappa`` grows with ``kappa`` (a weaker surface is
-  farther), its slope stays below 1 unless the softening outruns the
-  elasticity (material snap-back, which the calibration of
-  :mod:`mpm_warp.weak_layer` does not produce). Secant steps from ``kappa_n`` and
-  the explicit estimate (the projection on the current surface), kept in
-  ``[kappa_n, max(kappa_s, kappa_n + dkappa(b = 0))]`` with bisection as the
+  problem solved inside, ``dkappa`` the work of the increment to the surface of
+  ``kappa`` (a weaker surface is farther, its stress lower: ``f`` rises from
+  ``-dkappa(kappa_n) <= 0`` at ``kappa_n``, and its slope stays positive unless
+  the softening outruns the elasticity, a material snap-back, which the
+  calibration of :mod:`mpm_warp.scenes.weak_layer.calibration` does not
+  produce). Secant steps from ``kappa_n`` and the explicit estimate (the
+  projection on the current surface), kept in ``[kappa_n, max(kappa_s, kappa_n
+  + dkappa(b = 0))]`` (``f >= 0`` at the upper end) with bisection as the
   fall-back.
 
 Both stop on their residual (``g``, ``f``) at its rounding level, about
 ``2 eps (1 + |state|)``, so the returned state lies on its own surface: no
 period-2 cycling of an explicit hardening (camclay cycles when ``(1 - beta)/2
 xi cosh(xi x) > 1`` and the increment is large), projecting again changes
-nothing, and the bond drops by what the increment's plastic strain costs. A
+nothing, and the bond drops by the work the increment costs. A
 yielding point costs a projection plus two or three (bond) times two
 (volumetric) Newton evaluations: 5.2x camclay's return at a crack tip, 2.5x
 once the bond is gone (CPU, float32, ``benchmarks/bonded_return_cost.py``). The
@@ -308,7 +319,7 @@ def bonded_camclay_return_func(T):
     log_jp : T
         ``ln det F_P`` (dimensionless): intrinsic hardening state.
     kappa : T
-        Accumulated plastic strain (dimensionless, >= 0), the layer-column mean.
+        Plastic work done per unit volume (J/m^3, >= 0), the layer-column mean.
     mu, lam : T
         Lame parameters (Pa).
     M, beta, xi : T
@@ -319,7 +330,7 @@ def bonded_camclay_return_func(T):
     p_bond : T
         Bonded part of the consolidation pressure of the intact layer (Pa, >= 0).
     kappa_s : T
-        ``kappa`` at which the bond is gone (dimensionless, > 0; ``inf`` keeps it).
+        ``kappa`` at which the bond is gone (J/m^3, > 0; ``inf`` keeps it).
 
     Returns
     -------
@@ -329,7 +340,7 @@ def bonded_camclay_return_func(T):
     log_jp_new : T
         ``log_jp + tr(eps_tr) - tr(eps_new)``.
     kappa_new : T
-        ``kappa + |eps_tr - eps_new|``.
+        ``kappa`` plus the work of the new stress on ``eps_tr - eps_new`` (J/m^3).
     yielded : int32
         1 if the state was returned, 0 otherwise.
 
@@ -376,6 +387,7 @@ def bonded_camclay_return_strain_func(T):
     """
     v3 = vec3(T)
     sqrt6 = _SQRT6
+    sqrt2_3 = math.sqrt(2.0 / 3.0)
     eps = _eps(T)
     two_eps = 2.0 * eps
     max_it = _MAX_ITERATIONS
@@ -387,9 +399,9 @@ def bonded_camclay_return_strain_func(T):
 
     @wp.func
     def dkappa(p: T, q: T, p_tr: T, q_tr: T, K: T, mu: T):
-        ev = (p - p_tr) / K
+        # plastic work of the new stress (p, q) on the increment to it from the trial (J/m^3)
         ed = (q_tr - q) / (T(sqrt6) * mu)
-        return wp.sqrt(ed * ed + ev * ev / T(3.0))
+        return wp.max(p * (p_tr - p) / K + T(sqrt2_3) * q * ed, T(0.0))
 
     @wp.func
     def bonded_camclay_return_strain(e: v3, log_jp: T, kappa: T, mu: T, lam: T, M: T, beta: T, xi: T,
@@ -463,10 +475,11 @@ def bonded_camclay_return_strain_func(T):
             scale = wp.min(q / q_tr, T(1.0))
         m_new = -p / (T(3.0) * K)
         e_new = v3(dev[0] * scale + m_new, dev[1] * scale + m_new, dev[2] * scale + m_new)
-        # bookkeeping from the stored strains themselves: d = eps_tr - eps_new
+        # bookkeeping from the stored strains themselves: d = eps_tr - eps_new; the work of the new stress on it
         dv = tr - T(3.0) * m_new
         dd = wp.length(dev) * (T(1.0) - scale)
-        return e_new, log_jp + dv, kappa + wp.sqrt(dd * dd + dv * dv / T(3.0)), wp.int32(1)
+        work = wp.max(-p * dv + T(sqrt2_3) * q * dd, T(0.0))
+        return e_new, log_jp + dv, kappa + work, wp.int32(1)
 
     return bonded_camclay_return_strain
 
@@ -479,7 +492,7 @@ def kappa_column_sum_kernel(T):
     """Kernel ``kappa_column_sum(kappa, column, sums)``: ``sums[column[i]] += (kappa[i], 1)``.
 
     One thread per weak-layer particle. ``kappa`` (T, ``(n,)``): the group's
-    accumulated plastic strain; ``column`` (int32, ``(n,)``): the index of the
+    plastic work (J/m^3); ``column`` (int32, ``(n,)``): the index of the
     particle's lattice column (particles seeded at the same bed position,
     across the layer thickness), in ``[0, n_columns)``; ``sums`` (``wp.vec2d``,
     ``(n_columns,)``, zeroed before the launch): float64 sum and count.
@@ -505,7 +518,7 @@ def kappa_column_mean_kernel(T):
 
     One thread per weak-layer particle, after :func:`kappa_column_sum_kernel`.
     Every particle of a column then carries the column mean, so the bond
-    ``b = 1 - kappa/kappa_s`` is that of the layer's mean plastic strain at
+    ``b = 1 - kappa/kappa_s`` is that of the work done on the layer's thickness at
     its bed position (crack band = the layer, module docstring). Idempotent:
     a second pass leaves ``kappa`` unchanged (exactly in float32).
     """

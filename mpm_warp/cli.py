@@ -1,7 +1,8 @@
 """Command line: ``mpm-warp run|resume|scenes|info|render|plot|sweep ...`` (every subcommand is here).
 
 Errors the library raises on purpose (bad input, blow-ups) are printed as one
-clear line with exit status 2 (input) or 3 (simulation), never a traceback.
+clear line with exit status 2 (input, files) or 3 (simulation), never a traceback;
+so is any other OSError (a file system refusing a write).
 The commands call the library: :func:`mpm_warp.run`, :func:`mpm_warp.resume`,
 :func:`mpm_warp.post.render.render_run`, :func:`mpm_warp.post.plots.plot_run`,
 :func:`mpm_warp.sweep.run_sweep`.
@@ -11,6 +12,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
+import math
 import os
 import signal
 import sys
@@ -22,15 +25,24 @@ __all__ = ["main"]
 
 
 class StopRequest:
-    """SIGINT/SIGTERM handler that asks the run to stop at the next frame boundary.
+    """SIGINT/SIGTERM handler: stop the run with a checkpoint, never an unbounded wait.
 
-    Python may swallow a KeyboardInterrupt raised inside a callback, so the CLI
-    catches the signals itself; the run then ends after a complete frame and
-    says where its output and checkpoint are. A second signal aborts at once.
+    Python may swallow a KeyboardInterrupt raised inside a callback, so the CLI catches the
+    signals itself. A first signal lets the current frame finish when it is due within
+    :attr:`far_s` seconds of wall time (judged from the last frame's duration); otherwise, and
+    on a second signal, the simulation stops after its current batch of steps
+    (:meth:`mpm_warp.Simulation.request_stop`) with a checkpoint that resumes exactly. A third
+    signal aborts at once (complete frames are kept).
     """
 
-    def __init__(self):
+    def __init__(self, far_s: float = 2.0):
+        self.far_s = far_s
         self.requested = False
+        self.signals = 0
+        self.sim = None
+        self._now = False
+        self._frame_start = time.perf_counter()
+        self._frame_wall = None
         self._old = {}
 
     def __enter__(self):
@@ -42,11 +54,37 @@ class StopRequest:
         for sig, old in self._old.items():
             signal.signal(sig, old)
 
+    def attach(self, sim) -> None:
+        """The simulation to stop (a stop asked for before it existed applies now)."""
+        self.sim = sim
+        self._frame_start = time.perf_counter()
+        if self._now:
+            sim.request_stop()
+
+    def frame_done(self) -> None:
+        now = time.perf_counter()
+        self._frame_wall, self._frame_start = now - self._frame_start, now
+
+    def frame_due_in(self) -> float:
+        """Wall seconds until the current frame is expected to end (inf before a first frame)."""
+        if self._frame_wall is None:
+            return math.inf
+        return max(0.0, self._frame_wall - (time.perf_counter() - self._frame_start))
+
     def _handle(self, signum, frame):
-        if self.requested:
+        self.signals += 1
+        if self.signals >= 3:
             raise KeyboardInterrupt
         self.requested = True
-        sys.stderr.write("\nmpm-warp: stop requested; finishing the current frame (signal again to abort)\n")
+        if self.signals == 1 and self.frame_due_in() <= self.far_s:
+            sys.stderr.write("\nmpm-warp: stop requested; finishing the current frame (signal again to stop "
+                             "sooner)\n")
+            return
+        self._now = True
+        if self.sim is not None:
+            self.sim.request_stop()
+        sys.stderr.write("\nmpm-warp: stop requested; stopping after the current batch of steps with a checkpoint "
+                         "(signal again to abort at once)\n")
 
 
 class Progress:
@@ -63,8 +101,10 @@ class Progress:
         self.last = 0.0
 
     def __call__(self, sim, frame: int):
-        if self.stop is not None and self.stop.requested:
-            return False
+        if self.stop is not None:
+            self.stop.frame_done()
+            if self.stop.requested:
+                return False
         if self.quiet:
             return None
         now = time.perf_counter()
@@ -87,33 +127,50 @@ class Progress:
             self.stream.write("\n")
 
 
-def _summary(res, out=sys.stdout):
+class _StderrLines(logging.Handler):
+    """The library's warnings (e.g. a stale lock taken over) as ``mpm-warp: ...`` lines on the current stderr."""
+
+    def emit(self, record):
+        sys.stderr.write(f"mpm-warp: {record.getMessage()}\n")
+
+
+def _summary(res, out=None):
+    out = out or sys.stdout
     out.write(
         f"done: {res.frames} frames, {res.steps} steps, t = {res.sim_time:.6g} s, {res.n_particles} particles on "
         f"{res.device}; stepping {res.wall_time:.2f} s ({res.particle_steps_per_s / 1e6:.2f} M particle-steps/s)"
         + (f"; {res.edge_hits} particle clamps at the grid edge" if res.edge_hits else "")
+        + (f"; {res.inversions} inversions (det F_tr <= 0) and {res.floor_events} singular-value floor events"
+           if res.inversions or res.floor_events else "")
         + (f"\noutput: {res.output}" if res.output else "") + "\n")
     for k, v in res.scene_result.items():
         out.write(f"  {k}: {v}\n")
 
 
-def cmd_run(a) -> int:
-    from .loader import load_scenario
-    from .runner import simulation_for
+def _stopped(res, path) -> int:
+    where = f"; frames so far are in {path}, resume with `mpm-warp resume {path}`" if path else ""
+    print(f"mpm-warp: stopped at t = {res.sim_time:.6g} s on request{where}", file=sys.stderr)
+    return 130
 
-    sc = load_scenario(a.scenario, a.set)
-    sim = simulation_for(sc, device=a.device)
+
+def cmd_run(a) -> int:
+    from .runner import run
+
     with StopRequest() as stop:
-        prog = Progress(sc.time.end, stop=stop, quiet=a.quiet)
+        prog = Progress(math.inf, stream=sys.stderr, stop=stop, quiet=a.quiet)
+
+        def start(sim):
+            prog.end = sim.scenario.time.end
+            stop.attach(sim)
+
         try:
-            res = sim.run(a.out, callback=prog)
+            res = run(a.scenario, a.out, a.device, a.set, overwrite=a.overwrite, max_memory=a.max_memory,
+                      on_start=start, callback=prog)
         finally:
             prog.close()
     _summary(res)
-    if stop.requested:
-        where = f"; frames so far are in {a.out}, resume with `mpm-warp resume {a.out}`" if a.out else ""
-        print(f"mpm-warp: stopped at t = {res.sim_time:.6g} s on request{where}", file=sys.stderr)
-        return 130
+    if res.stopped:
+        return _stopped(res, a.out)
     if a.json:
         print(json.dumps({k: v for k, v in res.__dict__.items() if k != "monitors"}, default=str))
     return 0
@@ -122,9 +179,23 @@ def cmd_run(a) -> int:
 def cmd_resume(a) -> int:
     from .runner import resume
 
-    res = resume(a.run, device=a.device, end_time=a.end)
+    with StopRequest() as stop:
+        prog = Progress(math.inf, stream=sys.stderr, stop=stop, quiet=a.quiet)
+
+        def start(sim):
+            prog.end = a.end if a.end is not None else sim.scenario.time.end
+            stop.attach(sim)
+            steps = int(sim.state.steps.numpy()[0])
+            print(f"mpm-warp: resuming {a.run} after frame {sim.frame_index}, at t = {sim.time:.6g} s (step {steps}), "
+                  f"to t = {prog.end:.6g} s", file=sys.stderr)
+
+        try:
+            res = resume(a.run, device=a.device, end_time=a.end, callback=prog, max_memory=a.max_memory,
+                         on_start=start)
+        finally:
+            prog.close()
     _summary(res)
-    return 0
+    return _stopped(res, a.run) if res.stopped else 0
 
 
 def cmd_scenes(a) -> int:
@@ -147,7 +218,11 @@ def cmd_info(a) -> int:
 
 
 def cmd_render(a) -> int:
+    from .io import check_output_dir
     from .post.render import render_run
+
+    if a.out is not None:
+        check_output_dir(a.out)
 
     out = render_run(a.run, field=a.field, frames=a.frames, out_dir=a.out, video=a.video or False,
                      size=tuple(a.size), camera=a.camera, fps=a.fps)
@@ -159,7 +234,11 @@ def cmd_render(a) -> int:
 
 
 def cmd_plot(a) -> int:
+    from .io import check_output_dir
     from .post.plots import plot_run
+
+    if a.out is not None:
+        check_output_dir(a.out)
 
     files = plot_run(a.run, a.out)
     for f in files:
@@ -244,6 +323,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="cpu | cuda | cuda:N (default: MPM_WARP_DEVICE, then CUDA if present)")
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario value, e.g. --set time.end=0.5 --set materials.slab.E=2e6")
+    r.add_argument("--overwrite", action="store_true",
+                   help="replace an existing --out (never the scenario itself nor a non-regular file)")
+    r.add_argument("--max-memory", default=None, metavar="SIZE",
+                   help="refuse a scene whose memory estimate exceeds SIZE, e.g. 16G (the machine's available "
+                        "memory is always a limit)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--json", action="store_true", help="print the run summary as JSON")
     r.set_defaults(func=cmd_run)
@@ -251,7 +335,9 @@ def build_parser() -> argparse.ArgumentParser:
     rs = sub.add_parser("resume", help="continue a run from its last checkpoint")
     rs.add_argument("run", help="the run's HDF5 file (its checkpoint RUN.ckpt.h5 must sit beside it)")
     rs.add_argument("--device", default=None)
-    rs.add_argument("--end", type=float, default=None, help="new end time (s)")
+    rs.add_argument("--end", type=float, default=None, help="new end time (s), not before the checkpoint's")
+    rs.add_argument("--max-memory", default=None, metavar="SIZE", help="as for run")
+    rs.add_argument("--quiet", action="store_true", help="no progress bar")
     rs.set_defaults(func=cmd_resume)
 
     sc = sub.add_parser("scenes", help="list the ready scenes and the scene kinds, one line each")
@@ -270,12 +356,19 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     """Entry point of the ``mpm-warp`` command."""
     args = build_parser().parse_args(argv)
+    log = logging.getLogger("mpm_warp")
+    if not any(isinstance(h, _StderrLines) for h in log.handlers):
+        log.addHandler(_StderrLines())
+        log.propagate = False
     try:
         return args.func(args)
     except SimulationBlowUp as e:
         print(f"mpm-warp: {e}", file=sys.stderr)
         return 3
     except MPMError as e:
+        print(f"mpm-warp: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:                 # a file system refusing something the checks could not foresee
         print(f"mpm-warp: error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -11,6 +11,7 @@ the field, the value and the allowed range). Reading TOML files, overrides and s
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal, Protocol, get_args, runtime_checkable
 
@@ -20,13 +21,21 @@ from .materials import Elastic
 from .walls import WALL_KINDS, WallKind
 
 __all__ = ["Block", "Domain", "TimeControl", "Output", "Scenario", "SceneParams", "OUTPUT_FIELDS", "PRECISIONS",
-           "BOUNDARIES", "Precision", "Boundary"]
+           "BOUNDARIES", "Precision", "Boundary", "ON_INVERSION", "MAX_STEPS", "MAX_MACH"]
 
 Precision = Literal["float32", "float64"]
 PRECISIONS: tuple[str, ...] = get_args(Precision)
 Boundary = Literal[WallKind, "none"]
 #: conditions of the box faces: a wall kind, or "none" (no box walls)
 BOUNDARIES: tuple[str, ...] = (*WALL_KINDS, "none")
+OnInversion = Literal["report", "stop"]
+#: what a run does when P2G floors singular values or meets an inverted element (``Output.on_inversion``)
+ON_INVERSION: tuple[str, ...] = get_args(OnInversion)
+#: most steps a run may need (its first step size times this reaches time.end): far beyond any snow experiment
+#: (a PST of 1 s at dx = 2 mm takes ~1e6), so more means a typo in a modulus, a density, a speed or a time
+MAX_STEPS = 1.0e8
+#: fastest initial speed, in multiples of the fastest P-wave speed of the materials (snow: 70-300 m/s)
+MAX_MACH = 100.0
 #: particle fields the output may hold: name -> (per-particle shape, unit, description); "dim" is the scene's dimension
 OUTPUT_FIELDS = {
     "x": (("dim",), "m", "position"),
@@ -161,11 +170,16 @@ class Output:
         Write a checkpoint every this many frames (0: only the initial one).
     health_every : int
         Run the device health check every this many steps (>= 1).
+    on_inversion : {"report", "stop"}
+        "report" (default): count singular-value floor events and inversions (``det F_tr <= 0``)
+        and report them in the result; "stop": end the run (exit status 3) at the first health
+        check that finds one, naming the step and the counts.
     """
 
     fields: tuple = ("x",)
     checkpoint_every: int = 10
     health_every: int = 20
+    on_inversion: OnInversion = "report"
 
 
 @dataclass(frozen=True)
@@ -221,11 +235,14 @@ class Scenario:
             choice("output.fields[]", f_, tuple(OUTPUT_FIELDS))
         positive_int("output.checkpoint_every", out.checkpoint_every, lo=0)
         positive_int("output.health_every", out.health_every, lo=1)
-        outp = Output(tuple(dict.fromkeys(("x", *out.fields))), out.checkpoint_every, out.health_every)
+        choice("output.on_inversion", out.on_inversion, ON_INVERSION)
+        outp = Output(tuple(dict.fromkeys(("x", *out.fields))), out.checkpoint_every, out.health_every,
+                      out.on_inversion)
         choice("precision", self.precision, PRECISIONS)
         if self.scene is not None and not isinstance(self.scene, SceneParams):
             raise InvalidArgument("scene", self.scene, "typed scene parameters (e.g. mpm_warp.scenes.pst.PSTParams) "
                                   "or None; a scenario file's [scene] table is read by mpm_warp.loader")
+        _step_budget(tc, dom.dx, mats, blocks)
         return replace(self, domain=dom, time=tc, materials=mats, blocks=blocks, walls=walls, output=outp)
 
     def to_dict(self) -> dict:
@@ -240,7 +257,7 @@ class Scenario:
             "blocks": [],
             "walls": [w.to_dict() for w in self.walls],
             "output": {"fields": list(self.output.fields), "checkpoint_every": self.output.checkpoint_every,
-                       "health_every": self.output.health_every},
+                       "health_every": self.output.health_every, "on_inversion": self.output.on_inversion},
         }
         for b in self.blocks:
             bd = asdict(b)
@@ -274,9 +291,14 @@ def _domain(d: Domain) -> Domain:
 
 
 def _time(t: TimeControl, dim: int) -> TimeControl:
+    end = finite_number("time.end", t.end, lo=0.0, lo_open=True)
+    fi = finite_number("time.frame_interval", t.frame_interval, lo=0.0, lo_open=True)
+    if fi > end:
+        raise InvalidArgument("time.frame_interval", t.frame_interval, f"at most time.end = {end:g} s (a longer "
+                              "interval writes no frame but the initial and the last)")
     return TimeControl(
-        end=finite_number("time.end", t.end, lo=0.0, lo_open=True),
-        frame_interval=finite_number("time.frame_interval", t.frame_interval, lo=0.0, lo_open=True),
+        end=end,
+        frame_interval=fi,
         cfl=finite_number("time.cfl", t.cfl, lo=0.0, hi=1.0, lo_open=True),
         dt=finite_number("time.dt", t.dt, lo=0.0),
         dt_max=finite_number("time.dt_max", t.dt_max, lo=0.0),
@@ -300,7 +322,47 @@ def _block(b: Block, i: int, mats: dict, dom: Domain) -> Block:
         if blo[a] < lo[a] - 1e-9 * dx or bhi[a] > hi[a] + 1e-9 * dx:
             raise InvalidArgument(f"{w}.lo/hi[{a}]", (blo[a], bhi[a]),
                                   f"inside the domain [{lo[a]:g}, {hi[a]:g}] (particles inside the grid)")
+    size = [bhi[a] - blo[a] for a in range(dim)]
+    if dx > max(size) * (1 + 1e-9):        # a layer thinner than a cell (one particle across) is fine; a block
+        raise InvalidArgument("domain.dx", dx, (  # inside one cell is a few particles the grid cannot resolve
+            f"a spacing at most the largest extent of every block: {w} is " + " x ".join(f"{e:g}" for e in size)
+            + " m, inside one cell"))
     ppc = positive_int(f"{w}.particles_per_cell", b.particles_per_cell, lo=1, hi=8)
     vel = b.velocity if callable(b.velocity) else vector(
         f"{w}.velocity", (0.0,) * dim if b.velocity is None else b.velocity, dim)
     return Block(b.material, blo, bhi, vel, ppc, b.name or f"block{i}")
+
+
+def _step_budget(tc: TimeControl, dx: float, mats: dict, blocks) -> None:
+    """Refuse speeds, moduli and densities that would make a run take more than :data:`MAX_STEPS` steps.
+
+    The first step is ``dt = cfl dx / (c_p + |v|)`` (``time.dt`` if fixed, capped by ``time.dt_max``)
+    with ``c_p`` the fastest P-wave speed and ``|v|`` the fastest constant initial speed (a Python
+    velocity function is not evaluated here); an initial speed above :data:`MAX_MACH` ``c_p`` is
+    refused on its own.
+    """
+    name, fastest = max(((k, m) for k, m in mats.items() if any(b.material == k for b in blocks)),
+                        key=lambda km: km[1].p_wave_speed)
+    c_p = fastest.p_wave_speed
+    for i, b in enumerate(blocks):
+        if callable(b.velocity):
+            continue
+        speed = math.sqrt(sum(c * c for c in b.velocity))
+        if speed > MAX_MACH * c_p:
+            raise InvalidArgument(f"blocks[{i}].velocity", b.velocity, (
+                f"a speed at most {MAX_MACH:g} times the fastest P-wave speed, {MAX_MACH * c_p:.3g} m/s "
+                f"(c_p = {c_p:.3g} m/s of materials.{name}); |v| = {speed:.3g} m/s is Mach {speed / c_p:.3g}"))
+    vmax = max((math.sqrt(sum(c * c for c in b.velocity)) for b in blocks if not callable(b.velocity)), default=0.0)
+    if tc.dt > 0:
+        dt, field, value, why = tc.dt, "time.dt", tc.dt, "the fixed step"
+    else:
+        dt = tc.cfl * dx / (c_p + vmax)
+        field, value = f"materials.{name} (E, density)", (fastest.E, fastest.density)
+        why = (f"dt = cfl dx / (c_p + |v|) = {tc.cfl:g} x {dx:g} m / ({c_p:.3g} + {vmax:.3g} m/s) with c_p = "
+               f"{c_p:.3g} m/s of materials.{name}")
+    if tc.dt_max > 0 and tc.dt_max < dt:
+        dt, field, value, why = tc.dt_max, "time.dt_max", tc.dt_max, "the step cap time.dt_max"
+    steps = tc.end / dt
+    if steps > MAX_STEPS:
+        raise InvalidArgument(field, value, f"values giving at most {MAX_STEPS:.0e} steps to time.end = {tc.end:g} s: "
+                              f"{why} makes dt = {dt:.3g} s and {steps:.3g} steps")

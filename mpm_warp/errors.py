@@ -44,7 +44,7 @@ class SimulationBlowUp(MPMError, RuntimeError):
     cause : str
         Human-readable cause.
     checkpoint : str or None
-        Path of the last good checkpoint, if one was written.
+        Path of the last checkpoint, if one was written and verifies (its checksum matches).
     """
 
     def __init__(self, step: int, particle: int, field: str, cause: str, checkpoint: str | None = None,
@@ -55,7 +55,8 @@ class SimulationBlowUp(MPMError, RuntimeError):
         self.cause = cause
         self.checkpoint = checkpoint
         self.output = output
-        msg = f"simulation stopped at step {step}: particle {particle}, field {field!r}: {cause}"
+        who = f"particle {particle}, " if particle >= 0 else ""
+        msg = f"simulation stopped at step {step}: {who}field {field!r}: {cause}"
         if output:
             msg += f"; complete frames kept in {output}"
         if checkpoint:

@@ -35,8 +35,8 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 __all__ = ["load_scenario", "scenario_from_dict", "resolved_scenario", "scene_params_from_dict", "apply_overrides",
-           "split_override", "read_scenario_dict", "list_scenes", "scenarios_dir", "from_table", "material_from_table",
-           "TOP_LEVEL_KEYS", "GENERATED_SECTIONS"]
+           "split_override", "read_scenario_dict", "scenario_path", "list_scenes", "scenarios_dir", "from_table",
+           "material_from_table", "TOP_LEVEL_KEYS", "GENERATED_SECTIONS"]
 
 #: keys of a scenario file's top level
 TOP_LEVEL_KEYS = ("name", "description", "precision", "domain", "time", "materials", "blocks", "walls", "output",
@@ -246,26 +246,49 @@ def list_scenes() -> list[str]:
     return sorted(f[:-5] for f in os.listdir(scenarios_dir()) if f.endswith(".toml"))
 
 
-def read_scenario_dict(path_or_name: str) -> tuple[dict, str]:
-    """Read a scenario TOML file (a path, or the name of a ready scene): ``(raw dict, path)``."""
+def scenario_path(path_or_name) -> str:
+    """The TOML file of a scenario path or of a ready scene's name; :class:`ScenarioError` when neither exists."""
     path = os.fspath(path_or_name)
-    if not os.path.exists(path):
-        fname = path if path.endswith(".toml") else path + ".toml"
-        cand = os.path.join(scenarios_dir(), fname)
-        if not os.path.exists(cand):
-            raise ScenarioError(f"scenario {path_or_name!r} not found (neither a file nor a scene in "
-                                f"{scenarios_dir()}; known scenes: {', '.join(list_scenes())})")
-        path = cand
+    if os.path.exists(path):
+        return path
+    fname = path if path.endswith(".toml") else path + ".toml"
+    cand = os.path.join(scenarios_dir(), fname)
+    if not os.path.exists(cand):
+        raise ScenarioError(f"scenario {path_or_name!r} not found (neither a file nor a scene in "
+                            f"{scenarios_dir()}; known scenes: {', '.join(list_scenes())})")
+    return cand
+
+
+def read_scenario_dict(path_or_name: str) -> tuple[dict, str]:
+    """Read a scenario TOML file (a path, or the name of a ready scene): ``(raw dict, path)``.
+
+    Whatever the file holds (binary bytes, UTF-16 text, arrays nested hundreds deep, a folder),
+    the error is one :class:`ScenarioError` line naming the file.
+    """
+    path = scenario_path(path_or_name)
+    if os.path.isdir(path):
+        raise ScenarioError(f"{path}: is a directory, not a scenario file")
     try:
         with open(path, "rb") as fh:
             return tomllib.load(fh), path
     except tomllib.TOMLDecodeError as e:
         raise ScenarioError(f"{path}: not valid TOML: {e}") from None
+    except UnicodeDecodeError as e:
+        raise ScenarioError(f"{path}: not valid TOML: not UTF-8 text (byte {e.start}: "
+                            f"{e.object[e.start:e.start + 1]!r}; binary data or another encoding such as UTF-16)") \
+            from None
+    except RecursionError:
+        raise ScenarioError(f"{path}: not valid TOML for a scenario: arrays or tables nested too deeply") from None
+    except OSError as e:
+        raise ScenarioError(f"{path}: cannot be read ({e.strerror})") from None
 
 
 def load_scenario(path_or_name, overrides=None) -> Scenario:
     """Load, override and validate a scenario file or a ready scene by name."""
     raw, path = read_scenario_dict(path_or_name)
-    if overrides:
-        raw = apply_overrides(raw, overrides)
-    return scenario_from_dict(raw, source=path)
+    try:
+        if overrides:
+            raw = apply_overrides(raw, overrides)
+        return scenario_from_dict(raw, source=path)
+    except RecursionError:
+        raise ScenarioError(f"{path}: not valid TOML for a scenario: arrays or tables nested too deeply") from None

@@ -164,11 +164,12 @@ class CamClaySnow(Elastic):
 
 @dataclass(frozen=True)
 class BondedCamClay(Elastic):
-    """Bonded (structured) Cam-Clay weak layer: strength lost over a set plastic strain, then collapse.
+    """Bonded (structured) Cam-Clay weak layer: strength lost over a set plastic work, then collapse.
 
     The yield ellipse of MODEL.md 2 with ``p0 = p0_int(log_Jp) + b p_bond`` and
     cohesion ratio ``beta b``, ``b = max(0, 1 - kappa / kappa_s)`` the bond,
-    ``kappa`` the accumulated plastic strain (layer-column mean) and ``p0_int =
+    ``kappa`` the plastic work done per unit volume (J/m^3, layer-column mean: the
+    layer is debonded once it dissipated ``kappa_s D_wl`` per unit area) and ``p0_int =
     K sinh(xi max(-log_Jp, 0))`` the intrinsic hardening (MODEL.md 3b;
     :mod:`mpm_warp.kernels.bonded_camclay`). Kernel state: ``(log_jp, kappa)``.
     Build it from field measurements with :func:`mpm_warp.scenes.weak_layer.calibration.weak_layer_material`.
@@ -191,7 +192,7 @@ class BondedCamClay(Elastic):
     p_bond : float
         Bonded part of the consolidation pressure of the intact layer (Pa), >= 0.
     kappa_s : float
-        Accumulated plastic strain at which the bond is gone (-), > 0; ``inf`` keeps the bond.
+        Plastic work per unit volume at which the bond is gone (J/m^3), > 0; ``inf`` keeps the bond.
     """
 
     M: float = 1.2
@@ -200,7 +201,7 @@ class BondedCamClay(Elastic):
     p0_int_ini: float = 0.0
     p0_floor_ratio: float = 1e-5
     p_bond: float = 0.0
-    kappa_s: float = 0.01
+    kappa_s: float = 30.0
     model: str = field(default="bonded_camclay", init=False)
     plastic = True
 

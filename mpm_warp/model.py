@@ -23,9 +23,8 @@ from .kernels.grid_update import wall_struct
 from .kernels.types import mat, vec
 from .materials import BondedCamClay, CamClaySnow, Elastic
 
-__all__ = ["Model", "State", "ParticleGroup", "seed_block", "lattice_counts", "lattice_columns", "velocity_gradient",
-           "material_params",
-           "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
+__all__ = ["Model", "State", "ParticleGroup", "seed_block", "lattice_counts", "lattice_columns", "grid_shape",
+           "velocity_gradient", "material_params", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
 
 #: grid nodes added outside the domain box on each side
 GRID_PADDING = 3
@@ -57,6 +56,11 @@ class ParticleGroup:
     def count(self) -> int:
         """Number of particles in the group."""
         return self.end - self.start
+
+
+def grid_shape(lo, hi, dx: float) -> tuple[int, ...]:
+    """Grid nodes per axis of the domain ``[lo, hi]`` with spacing ``dx``, :data:`GRID_PADDING` nodes outside it."""
+    return tuple(int(math.ceil((hi[a] - lo[a]) / dx - 1e-9)) + 2 * GRID_PADDING + 1 for a in range(len(lo)))
 
 
 def seed_block(lo, hi, dx: float, ppc: int) -> tuple[np.ndarray, float]:
@@ -165,9 +169,7 @@ class Model:
         lo = np.asarray(dom.lo, dtype=np.float64)
         hi = np.asarray(dom.hi, dtype=np.float64)
         self.origin = lo - GRID_PADDING * self.dx
-        self.grid_shape = tuple(
-            int(math.ceil((hi[a] - lo[a]) / self.dx - 1e-9)) + 2 * GRID_PADDING + 1 for a in range(self.dim)
-        )
+        self.grid_shape = grid_shape(lo, hi, self.dx)
         # particles must keep their 3^dim stencil inside the grid: grid coordinate in [1, n - 2]
         self.x_lo = self.origin + 1.0 * self.dx
         self.x_hi = self.origin + (np.asarray(self.grid_shape) - 2.0) * self.dx
@@ -288,8 +290,8 @@ class State:
         Steps taken.
     """
 
-    #: the arrays a checkpoint holds (those that exist)
-    CHECKPOINT_FIELDS = ("x", "v", "C", "H", "hzz", "log_jp", "kappa", "clock", "steps")
+    #: the arrays a checkpoint holds (those that exist; ``yielded`` holds the flags of a frame stopped half-way)
+    CHECKPOINT_FIELDS = ("x", "v", "C", "H", "hzz", "log_jp", "kappa", "yielded", "clock", "steps")
 
     def __init__(self, model: Model, x, v, C, log_jp, kappa, track_yield: bool):
         dev = model.device
@@ -337,19 +339,20 @@ class State:
             self.hzz.assign((F[:, 2, 2] - 1.0).astype(self.model.np_dtype))
 
     def arrays(self) -> dict[str, np.ndarray]:
-        """Host copies of the full state (for checkpoints)."""
+        """Host copies of the full state (checkpoints, snapshots): copies, never views of the device
+        memory (on the CPU ``wp.array.numpy()`` is a view, which the next step would overwrite)."""
         d = {}
         for k in self.CHECKPOINT_FIELDS:
             a = getattr(self, k)
             if a is not None:
-                d[k] = a.numpy()
+                d[k] = np.array(a.numpy(), copy=True)
         return d
 
     def load_arrays(self, d: dict[str, np.ndarray]) -> None:
         """Restore the state from :meth:`arrays` output (bit for bit)."""
         for k in self.CHECKPOINT_FIELDS:
             dst = getattr(self, k)
-            if dst is None:
+            if dst is None or (k == "yielded" and k not in d):   # older checkpoints hold no yielded flags
                 continue
             a = np.asarray(d[k])
             if k == "clock" and a.shape[0] < dst.shape[0]:  # a 3-entry clock of an older checkpoint

@@ -50,6 +50,14 @@ class RunResult:
         The monitors' results (:meth:`mpm_warp.monitor.Monitor.result`), e.g. a PST's crack speed.
     monitors : dict of str -> Monitor
         The monitors of the run by name (their recorded series, device arrays).
+    floor_events : int
+        Particle updates in this call whose elastic singular values were floored at
+        ``SINGULAR_VALUE_FLOOR`` (an element crushed to almost nothing; ``kernels/p2g.py``).
+    inversions : int
+        Particle updates in this call with an inverted trial state, ``det F_tr <= 0`` (then floored too).
+        ``output.on_inversion = "stop"`` ends the run at the first health check that sees either.
+    stopped : bool
+        The run ended before its end time on request (a callback, a signal, :meth:`Simulation.request_stop`).
     """
 
     output: str | None
@@ -63,6 +71,9 @@ class RunResult:
     edge_hits: int = 0
     scene_result: dict = field(default_factory=dict)
     monitors: dict = field(default_factory=dict)
+    floor_events: int = 0
+    inversions: int = 0
+    stopped: bool = False
 
     @property
     def monitor(self) -> Monitor | None:

@@ -1,34 +1,55 @@
 """The one way to run anything: :func:`run` (a scenario, a file or a ready scene) and :func:`resume`.
 
-Both build the :class:`~mpm_warp.Simulation`, attach the scene's monitor when the scenario has a
-scene (:func:`mpm_warp.scenes.attach`), run, and return the :class:`~mpm_warp.RunResult` with the
-scene's result (``scene_result``) and its monitor (``monitor``).
+Both first claim the output (:func:`claimed_output`: the path is checked, never the input
+scenario nor a non-regular file, and locked against a second run), then build the
+:class:`~mpm_warp.Simulation` (its memory estimate checked before anything is allocated),
+attach the scene's monitor when the scenario has a scene (:func:`mpm_warp.scenes.attach`), run,
+and return the :class:`~mpm_warp.RunResult` with the scene's result (``scene_result``) and its
+monitor (``monitor``).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+from collections.abc import Callable
 
 from . import io
 from .config import Scenario
-from .loader import load_scenario, resolved_scenario
+from .errors import InvalidArgument
+from .loader import load_scenario, resolved_scenario, scenario_path
 from .result import RunResult
 from .scenes import attach
 from .simulation import Simulation
 
-__all__ = ["run", "resume", "simulation_for"]
+__all__ = ["run", "resume", "simulation_for", "claimed_output"]
 
 
 def simulation_for(scenario: Scenario, device: str | None = None, n_threads: int | None = None,
-                   use_graph: bool | None = None) -> Simulation:
+                   use_graph: bool | None = None, max_memory=None) -> Simulation:
     """A :class:`Simulation` of ``scenario`` with its scene's monitor attached (if it has a scene)."""
-    sim = Simulation(scenario, device=device, use_graph=use_graph, n_threads=n_threads)
+    sim = Simulation(scenario, device=device, use_graph=use_graph, n_threads=n_threads, max_memory=max_memory)
     attach(sim)
     return sim
 
 
+@contextlib.contextmanager
+def claimed_output(output, *, overwrite: bool = False, inputs=(), append: bool = False):
+    """Check run file ``output`` (:func:`mpm_warp.io.check_output_file`) and hold its lock for the block.
+
+    Yields the path as a ``str`` (None when ``output`` is None: nothing to claim).
+    """
+    if output is None:
+        yield None
+        return
+    output = io.check_output_file(output, overwrite=overwrite, inputs=inputs, append=append)
+    with io.output_lock(output):
+        yield output
+
+
 def run(scenario, output: str | None = None, device: str | None = None, overrides=None, *,
-        n_threads: int | None = None, use_graph: bool | None = None, **run_kwargs) -> RunResult:
+        n_threads: int | None = None, use_graph: bool | None = None, overwrite: bool = False, max_memory=None,
+        on_start: Callable[[Simulation], None] | None = None, **run_kwargs) -> RunResult:
     """Run a scenario and return its :class:`RunResult`.
 
     Parameters
@@ -37,12 +58,19 @@ def run(scenario, output: str | None = None, device: str | None = None, override
         A scenario, a TOML file, or the name of a ready scene (``mpm-warp scenes``).
     output : str, optional
         HDF5 run file (a checkpoint ``<run>.ckpt.h5`` is written beside it); None runs without output.
+        An existing file is refused unless ``overwrite``; the input scenario and non-regular files
+        always are; a second run on the same output fails at once (:func:`claimed_output`).
     device : str, optional
         ``"cpu"``, ``"cuda"``, ``"cuda:N"``; default ``MPM_WARP_DEVICE``, then CUDA if present.
     overrides : list of str or dict, optional
         ``section.key=value`` overrides of a file or ready scene (as ``--set``).
-    n_threads, use_graph
+    n_threads, use_graph, max_memory
         As :class:`~mpm_warp.Simulation`.
+    overwrite : bool
+        Replace an existing ``output`` (and its checkpoint).
+    on_start : callable, optional
+        ``on_start(sim)`` once the simulation is built, before it runs (e.g. to keep it for
+        :meth:`Simulation.request_stop`).
     **run_kwargs
         ``end_time``, ``frame_interval``, ``callback`` of :meth:`Simulation.run`.
 
@@ -51,25 +79,41 @@ def run(scenario, output: str | None = None, device: str | None = None, override
     RunResult
         With ``scene_result`` (e.g. a PST's crack speed) and ``monitor`` (the scene's series).
     """
-    if not isinstance(scenario, Scenario):
-        scenario = load_scenario(os.fspath(scenario), overrides)
-    elif overrides:
-        from .errors import InvalidArgument
-
-        raise InvalidArgument("overrides", overrides, "None with a Scenario object (use dataclasses.replace)")
-    sim = simulation_for(scenario, device, n_threads, use_graph)
-    return sim.run(output, **run_kwargs)
+    if isinstance(scenario, Scenario):
+        if overrides:
+            raise InvalidArgument("overrides", overrides, "None with a Scenario object (use dataclasses.replace)")
+        inputs = ()
+    else:
+        scenario = os.fspath(scenario)
+        inputs = (scenario_path(scenario),)
+    with claimed_output(output, overwrite=overwrite, inputs=inputs) as output:
+        if not isinstance(scenario, Scenario):
+            scenario = load_scenario(scenario, overrides)
+        sim = simulation_for(scenario, device, n_threads, use_graph, max_memory)
+        if on_start is not None:
+            on_start(sim)
+        return sim.run(output, overwrite=overwrite, **run_kwargs)
 
 
 def resume(output, device: str | None = None, end_time: float | None = None, callback=None,
-           n_threads: int | None = None) -> RunResult:
+           n_threads: int | None = None, max_memory=None,
+           on_start: Callable[[Simulation], None] | None = None) -> RunResult:
     """Continue the run stored in ``output`` from its last checkpoint, monitors included.
 
-    The run file is truncated to the checkpoint's frame and extended; on the CPU a resumed run
-    matches an uninterrupted one bit for bit (positions, ``log_jp``, the monitors' series and result).
+    The checkpoint is verified (SHA-256) and the run file's kept frames are read once (a damaged
+    one stops the resume); the file is then truncated to the checkpoint's frame and extended. On
+    the CPU a resumed run matches an uninterrupted one bit for bit (positions, ``log_jp``, the
+    monitors' series and result), also from a checkpoint written mid-frame by
+    :meth:`Simulation.request_stop`. ``end_time`` before the checkpoint's time is refused.
     """
-    output = os.fspath(output)
-    meta = io.read_checkpoint_meta(io.checkpoint_path_for(output))
-    sim = simulation_for(resolved_scenario(meta["scenario"], source=output), device, n_threads)
-    sim.restore(output)
-    return sim.run(output, end_time=end_time, callback=callback, append=True)
+    with claimed_output(output, append=True) as output:
+        meta = io.read_checkpoint_meta(io.checkpoint_path_for(output))
+        sim = simulation_for(resolved_scenario(meta["scenario"], source=output), device, n_threads,
+                             max_memory=max_memory)
+        sim.restore(output)
+        if end_time is not None and end_time < sim.time * (1 - 1e-12):
+            raise InvalidArgument("end_time", end_time, f"a time after the checkpoint's t = {sim.time:.6g} s, from "
+                                  "which the run continues")
+        if on_start is not None:
+            on_start(sim)
+        return sim.run(output, end_time=end_time, callback=callback, append=True)

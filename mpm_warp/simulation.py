@@ -8,18 +8,18 @@ flags, a few bytes) and at frames (output fields).
 from __future__ import annotations
 
 import math
-import os
 import time as _time
 from collections.abc import Callable
 
 import numpy as np
 import warp as wp
 
-from . import io
+from . import io, snapshot
 from .config import OUTPUT_FIELDS, Scenario
 from .device import resolve_device
-from .errors import InvalidArgument, OutputError, SimulationBlowUp
+from .errors import InvalidArgument, SimulationBlowUp
 from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_kernel
+from .memory import check_memory
 from .model import Model, ParticleGroup, State, material_params
 from .monitor import GroupState, Monitor
 from .result import RunResult, versions
@@ -46,6 +46,9 @@ class Simulation:
         CPU threads for the step (default: all cores for scenes of 20k particles
         or more; ``MPM_WARP_THREADS`` overrides). Results depend on the thread
         count at round-off level only (the order grid copies are summed in).
+    max_memory : int, str or None
+        Refuse a scenario whose memory estimate exceeds this (bytes, or e.g. ``"16G"``); the
+        machine's available memory is always a limit (:func:`mpm_warp.memory.check_memory`).
 
     A snow scene's saw, push and diagnostics are its monitor, attached by :func:`mpm_warp.run`.
 
@@ -56,9 +59,11 @@ class Simulation:
     """
 
     def __init__(self, scenario: Scenario, device: str | None = None, use_graph: bool | None = None,
-                 n_threads: int | None = None):
+                 n_threads: int | None = None, max_memory=None):
         self.scenario = scenario.validate()
         self.device = resolve_device(device)
+        #: the memory estimate, checked before anything is allocated
+        self.memory = check_memory(self.scenario, self.device, n_threads, max_memory)
         self.model = Model(self.scenario, self.device)
         fields_ = self.scenario.output.fields
         self.state: State = self.model.initial_state(track_yield="yielded" in fields_)
@@ -71,6 +76,7 @@ class Simulation:
         self._bad = wp.full(3, INT_MAX, dtype=wp.int32, device=self.device)
         self._energy = wp.zeros(2, dtype=wp.float64, device=self.device)
         self._no_log_jp = wp.zeros(0, dtype=self.model.T, device=self.device)  # elastic groups: no plastic volume
+        self._stop_now = False
 
     # ----------------------------------------------------------------- public
     @property
@@ -197,6 +203,14 @@ class Simulation:
             if bad[k] != INT_MAX:
                 t, dt, steps = self.stepper.clock()
                 raise SimulationBlowUp(steps, int(bad[k]), fld, f"{cause} at t = {t:.6g} s")
+        if self.scenario.output.on_inversion == "stop":
+            floors, inversions = self.stepper.deformation_events()
+            if floors or inversions:
+                t, dt, steps = self.stepper.clock()
+                raise SimulationBlowUp(steps, -1, "F", (
+                    f"{inversions} inversion{'s' * (inversions != 1)} (det F_tr <= 0) and {floors} singular-value "
+                    f"floor event{'s' * (floors != 1)} by t = {t:.6g} s (output.on_inversion = 'stop'; 'report' "
+                    "runs on and counts them)"))
 
     def step_to(self, t_end: float, health_every: int | None = None) -> int:
         """Advance to ``t_end`` (s) exactly; return the steps taken.
@@ -222,7 +236,14 @@ class Simulation:
                 self.health()
                 self._since_health = 0
             dt = dt_new if dt_new > 0 else dt
+            if self._stop_now:
+                break
         return taken
+
+    def request_stop(self) -> None:
+        """Make a running :meth:`run` stop after its current batch of steps (at most ``output.health_every``),
+        mid-frame, with a checkpoint that resumes exactly; safe to call from a signal handler."""
+        self._stop_now = True
 
     def _first_dt(self) -> float:
         tc = self.scenario.time
@@ -233,24 +254,35 @@ class Simulation:
 
     # -------------------------------------------------------------------- run
     def run(self, output: str | None = None, end_time: float | None = None, frame_interval: float | None = None,
-            callback: Callable[[Simulation, int], bool | None] | None = None, append: bool = False) -> RunResult:
+            callback: Callable[[Simulation, int], bool | None] | None = None, append: bool = False,
+            overwrite: bool = False) -> RunResult:
         """Run to ``end_time`` writing a frame every ``frame_interval``.
 
         Parameters
         ----------
         output : str or None
-            HDF5 path; None runs without output.
+            HDF5 path; None runs without output. It is checked (:func:`mpm_warp.io.check_output_file`) and
+            locked (:func:`mpm_warp.io.output_lock`) before anything else.
         end_time, frame_interval : float or None
             Override the scenario's ``time.end`` / ``time.frame_interval`` (s).
         callback : callable or None
             ``callback(sim, frame)`` after every frame; returning False stops the run.
         append : bool
             Continue an existing output (used by :func:`resume`).
+        overwrite : bool
+            Replace an existing ``output`` (a regular file only).
 
         Returns
         -------
         RunResult
         """
+        if output is None:
+            return self._run(None, end_time, frame_interval, callback, append)
+        output = io.check_output_file(output, overwrite=overwrite, append=append)
+        with io.output_lock(output):
+            return self._run(output, end_time, frame_interval, callback, append)
+
+    def _run(self, output, end_time, frame_interval, callback, append) -> RunResult:
         tc = self.scenario.time
         end = tc.end if end_time is None else end_time
         fi = tc.frame_interval if frame_interval is None else frame_interval
@@ -259,20 +291,24 @@ class Simulation:
         n_frames_total = int(math.ceil(end / fi - 1e-9))
         if output:
             if append:
-                writer = io.RunWriter.reopen(output, keep_frames=self.frame_index + 1)
+                # restore() read every kept frame already
+                writer = io.RunWriter.reopen(output, keep_frames=self.frame_index + 1, verify=False)
             else:
                 writer = self._open_writer(output)
                 self._write_frame(writer)
                 self._checkpoint(ckpt)
         elif not append:
             self._frame_diagnostics()
-        self._last_frame_time = self.time
+        if not append:
+            self._last_frame_time = self.time
         # warm up: compile every kernel before timing
         self._compile()
         steps_total = 0
         frames = 0
         wall = 0.0
         edge0 = self.stepper.edge_count()[0]
+        events0 = self.stepper.deformation_events()
+        stopped = False
         try:
             while self.frame_index < n_frames_total:
                 t_next = min((self.frame_index + 1) * fi, end)
@@ -280,6 +316,11 @@ class Simulation:
                 steps_total += self.step_to(t_next)
                 wp.synchronize_device(self.device)
                 wall += _time.perf_counter() - t0
+                if self._stop_now and self.time < t_next * (1 - 1e-12) - 1e-15:   # stopped mid-frame
+                    self.health()
+                    self._checkpoint(ckpt)
+                    stopped = True
+                    break
                 self.frame_index += 1
                 frames += 1
                 self.health()  # never write a bad state into a frame or a checkpoint
@@ -291,24 +332,28 @@ class Simulation:
                         self._checkpoint(ckpt)
                 else:
                     self._frame_diagnostics()
-                if callback is not None and callback(self, self.frame_index) is False:
+                if (callback is not None and callback(self, self.frame_index) is False) or self._stop_now:
                     if writer is not None:
                         self._checkpoint(ckpt)  # a stop on request can be resumed from exactly here
+                    stopped = True
                     break
         except SimulationBlowUp as e:
             e.output = output
-            e.checkpoint = ckpt if ckpt and os.path.exists(ckpt) else None
+            e.checkpoint = ckpt if ckpt and io.checkpoint_is_intact(ckpt) else None
             e.args = (str(SimulationBlowUp(e.step, e.particle, e.field, e.cause, e.checkpoint, e.output)),)
             raise
         finally:
+            self._stop_now = False
             if writer is not None:
                 writer.close()
         n = self.model.n_particles
         result = {}
         for m in self.monitors.values():
             result.update(m.result())
+        floors, inversions = (a - b for a, b in zip(self.stepper.deformation_events(), events0, strict=True))
         return RunResult(output, steps_total, frames, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
-                         n, self.device, self.stepper.edge_count()[0] - edge0, result, dict(self.monitors))
+                         n, self.device, self.stepper.edge_count()[0] - edge0, result, dict(self.monitors),
+                         floors, inversions, stopped)
 
     def _compile(self) -> None:
         """Load every kernel of the plan (compiling on first use) without stepping."""
@@ -369,36 +414,22 @@ class Simulation:
             out.update(m.frame_scalars(self))
         return out
 
+    def snapshot(self) -> tuple[dict[str, np.ndarray], dict]:
+        """The whole state of the run in memory (:func:`mpm_warp.snapshot.take_snapshot`): what a checkpoint holds."""
+        return snapshot.take_snapshot(self)
+
+    def load_snapshot(self, arrays: dict[str, np.ndarray], meta: dict) -> None:
+        """Continue from a :meth:`snapshot` (:func:`mpm_warp.snapshot.load_snapshot`); e.g. a fork."""
+        snapshot.load_snapshot(self, arrays, meta)
+
     def _checkpoint(self, path: str | None) -> None:
-        if path is None:
-            return
-        meta = {"frame_index": self.frame_index, "scenario": self.scenario.to_dict(), "device": self.device,
-                "monitors": sorted(self.monitors)}
-        arrays = self.state.arrays()
-        # the next step's speed bound, so resume is bit for bit; one number, so any thread count or device resumes
-        arrays["vmax"] = np.asarray([self.stepper.vmax.numpy().max()])
-        for name, m in self.monitors.items():
-            arrays.update({f"monitors/{name}/{k}": np.asarray(a) for k, a in m.state().items()})
-        io.write_checkpoint(path, arrays, meta)
+        if path is not None:
+            io.write_checkpoint(path, *self.snapshot())
 
     def restore(self, output: str) -> None:
-        """Load the last checkpoint of the run file ``output``: state, step bound, monitors, frame count.
+        """Load the last checkpoint of the run file ``output`` (:func:`mpm_warp.snapshot.restore_run`).
 
         Attach the same monitors first (their state is restored into them); on the CPU the run then
         continues bit for bit as if never stopped.
         """
-        ckpt = io.checkpoint_path_for(output)
-        arrays, meta = io.read_checkpoint(ckpt)
-        if set(meta.get("monitors", [])) != set(self.monitors):
-            raise OutputError(f"{ckpt}: holds the state of the monitors {sorted(meta.get('monitors', []))}, "
-                              f"this simulation has {sorted(self.monitors)}")
-        self.state.load_arrays(arrays)
-        if "vmax" in arrays:
-            self.stepper.vmax.fill_(float(np.max(arrays["vmax"])))
-        else:
-            self.stepper.seed_vmax()
-        for name, m in self.monitors.items():
-            prefix = f"monitors/{name}/"
-            m.load_state({k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)})
-        self.frame_index = int(meta["frame_index"])
-        self.x0[...] = io.read_run(output).static["x0"]
+        snapshot.restore_run(self, output)

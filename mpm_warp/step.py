@@ -23,7 +23,7 @@ from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec
 from .model import Model, State, material_params
 
-__all__ = ["Stepper", "default_threads"]
+__all__ = ["Stepper", "default_threads", "grid_copies"]
 
 
 def default_threads(device: str, n_particles: int) -> int:
@@ -34,6 +34,13 @@ def default_threads(device: str, n_particles: int) -> int:
     if env:
         return max(1, int(env))
     return max(1, min(os.cpu_count() or 1, 64))
+
+
+def grid_copies(device: str, n_particles: int, grid_shape, n_threads: int | None = None) -> int:
+    """Threads of the CPU step, one grid copy each: :func:`default_threads` (or ``n_threads``), at most one per
+    3 grid slabs along x and per 1000 particles; 1 on CUDA."""
+    nt = n_threads or default_threads(device, n_particles)
+    return max(1, min(nt, grid_shape[0] // 3, max(1, n_particles // 1000)))
 
 
 def _chunks(start: int, end: int, n: int) -> list[tuple[int, int]]:
@@ -69,9 +76,7 @@ class Stepper:
         dim = model.dim
         V = vec(dim, T)
         Vi = wp.types.vector(dim, wp.int32)
-        nt = n_threads or default_threads(dev, model.n_particles)
-        nt = max(1, min(nt, model.grid_shape[0] // 3, max(1, model.n_particles // 1000)))
-        self.n_threads = nt
+        nt = self.n_threads = grid_copies(dev, model.n_particles, model.grid_shape, n_threads)
         gs = model.grid_shape
         n_nodes = int(np.prod(gs))
         # the kernels see the grid flat (node (i, j[, k]) at i s_0 + j s_1 [+ k]), copy k at k n_nodes

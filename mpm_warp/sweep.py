@@ -33,6 +33,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import datetime
+import functools
 import hashlib
 import itertools
 import json
@@ -204,7 +205,8 @@ def _run_case(task: dict) -> dict:
 
         rec["worker"] = get_worker().address
         scenario = scenario_from_dict(apply_overrides(task["raw"], dict(task["overrides"])), task["source"])
-        res = (task["runner"] or run)(scenario, out + ".part.h5", device=_worker_device(task["device"]))
+        runner = task["runner"] or functools.partial(run, overwrite=True)   # a dead worker's .part.h5 is replaced
+        res = runner(scenario, out + ".part.h5", device=_worker_device(task["device"]))
         data = io.read_run(out + ".part.h5")
         rec.update(status="ok", result={k: getattr(res, k) for k in RESULT_FIELDS}, scene_result=dict(res.scene_result),
                    final={k: float(v[-1]) for k, v in data.scalars.items() if len(v)}, n_frames=data.n_frames)

@@ -143,7 +143,7 @@ def test_driver_takes_initial_states_and_reports_trial_strains():
                                rtol=0, atol=1e-13)
 
 
-WL = mw.BondedCamClay(1.0e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.01, p_bond=1500.0, kappa_s=0.02)
+WL = mw.BondedCamClay(1.0e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.01, p_bond=1500.0, kappa_s=20.0)
 
 
 @pytest.mark.parametrize("dim", [2, 3])

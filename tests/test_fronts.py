@@ -6,9 +6,8 @@ import numpy as np
 import pytest
 
 from mpm_warp.materials import Elastic, hardening_collapse
-from mpm_warp.scenes import fronts
-from mpm_warp.scenes.pst import PSTParams, Saw, pst_summary, references
-from mpm_warp.scenes.pst.params import Front
+from mpm_warp.scenes import fronts, references
+from mpm_warp.scenes.pst import Front, PSTParams, Saw, pst_summary
 from mpm_warp.scenes.shear_test import shear_summary
 from mpm_warp.scenes.snow import Settle
 
@@ -167,43 +166,60 @@ def test_shear_summary_on_synthetic_curve():
 
 
 # ----------------------------------------------------------------------------- PST summary
-def _synthetic_pst(c=30.0, l_td=1.2, h=0.004, reverse=False):
-    """Parameters, frame series and bin arrival times of an ideal PST (front at speed c from t0)."""
-    L, cut, bw, t0 = 5.0, 0.4, 0.02, 0.2
-    # the saw runs from t = 0.1 s at 4 m/s: it stops at t0 = 0.2 s; markers every 0.1 m from 0.05 m
-    scene = PSTParams(length=L, dx=0.01, marker_spacing=0.1, settle=Settle(gravity_ramp=0.05, duration=0.1),
-                      saw=Saw(speed=4.0, cut_length=cut, from_end="left"), front=Front(bin=bw))
-    markers = scene.markers()
-    assert scene.saw_end == pytest.approx(t0) and markers[0] == pytest.approx(0.05)
-    t = np.arange(0.0, 0.5, 0.002)
+def _synthetic_pst(c=30.0, l_td=1.2, h=0.004, reverse=False, lead=0.0):
+    """Parameters, frame series and bin arrival times of an ideal PST: the saw (1 m/s from t = 0.1 s) cuts
+    0.4 m, the damage front runs at ``c`` from the cut once the blade stops (t0 = 0.5 s) and the slab
+    deflects behind it (reaching the deflection threshold ``lead`` metres behind the damage)."""
+    L, cut, bw, t0 = 6.0, 0.4, 0.02, 0.5
+    scene = PSTParams(length=L, dx=0.005, settle=Settle(gravity_ramp=0.05, duration=0.1),
+                      saw=Saw(speed=1.0, cut_length=cut, from_end="left"), front=Front(bin=bw))
+    assert scene.saw_end == pytest.approx(t0)
+    t = np.arange(0.0, 0.8, 0.002)
     sb = (np.arange(int(L / bw)) + 0.5) * bw
+    saw_t = 0.1 + sb / 1.0
     if reverse:  # everything beyond the cut fails from the far end towards the saw
-        tb = np.where(sb <= cut, 0.1 + sb / 4.0, t0 + (L - sb) / c)
+        tb = np.where(sb <= cut, saw_t, t0 + (L - sb) / c)
     else:
-        tb = np.where(sb <= cut, 0.1 + sb / 4.0, t0 + (sb - cut) / c)
-    front = np.array([fronts.front_from_arrival(tb, ti, bw) for ti in t])
-    series = {"front": front, "collapse_height": np.full(t.size, h)}
-    for k, m in enumerate(markers):  # slab base: 0 ahead of the front, h behind the touchdown point
-        x = np.clip((front - m) / l_td, 0.0, 1.0) * (m < front)
-        series[f"marker{k}_uy"] = -h * (3 * x**2 - 2 * x**3)
-    return scene, t, series, (sb, tb)
+        tb = np.where(sb <= cut, saw_t, t0 + (sb - cut) / c)
+    td = tb + lead / c
+    deflection = np.array([fronts.front_from_arrival(td, ti, bw) for ti in t])
+    td_series = np.where(deflection > cut + 4 * bw, l_td, np.nan)
+    series = {"front": np.array([fronts.front_from_arrival(tb, ti, bw) for ti in t]),
+              "deflection_front": deflection, "touchdown": td_series, "collapse_height": np.full(t.size, h)}
+    return scene, t, series, sb, tb, td
 
 
 def test_pst_summary_on_ideal_front():
-    scene, t, series, arrival = _synthetic_pst()
-    out = pst_summary(scene, t, series, arrival=arrival)
-    assert out["speed"] == pytest.approx(30.0, rel=1e-6)
-    assert out["speed_frames"] == pytest.approx(30.0, rel=0.05)
-    assert out["propagated"] and out["ran_to_end"] and out["initiated_at_saw"]
-    x95 = 0.5 + math.cos((math.acos(1 - 2 * 0.95) + 4 * math.pi) / 3)
-    assert out["touchdown"] == pytest.approx(1.2 * x95, abs=0.1)
-    assert out["collapse_height"] == 0.004
+    scene, t, series, sb, tb, td = _synthetic_pst()
+    out = pst_summary(scene, t, series, sb, tb, td)
+    assert out["damage_speed_mean"] == pytest.approx(30.0, rel=1e-3)
+    assert out["deflection_speed_mean"] == pytest.approx(30.0, rel=1e-3)
+    assert out["speed"] == out["damage_speed_mean"] and out["front_agreement"] == pytest.approx(1.0, rel=1e-3)
+    assert out["damage_speed_mean_over"] == [0.4, 3.4]
+    prof = out["damage_speed_profile"]
+    assert np.allclose(prof["speed"], 30.0, rtol=1e-3) and prof["s"][0] == pytest.approx(0.4 + 0.25)
+    assert out["damage_speed_max"] == pytest.approx(30.0, rel=1e-3)
+    assert out["propagated"] and out["ran_to_end"]
+    assert out["damage_front_final"] == pytest.approx(6.0)
+    # the crack ran away from the blade as it stopped: the lead of 0.3 m was reached with the blade at 0.4 m
+    assert out["runaway_cut"] == pytest.approx(0.4)
+    assert out["max_damage_lead"] <= 0.02      # no bin damaged ahead of the contiguous front
+    assert out["touchdown"] == pytest.approx(1.2) and out["collapse_height"] == 0.004
+    assert out["heierli_speed_run"] == pytest.approx(
+        references.heierli_speed(scene.slab.E, scene.slab_thickness, scene.slab.density, 0.004))
+
+
+def test_pst_summary_lagging_deflection_and_an_arrest():
+    scene, t, series, sb, tb, td = _synthetic_pst(lead=0.5)
+    out = pst_summary(scene, t, series, sb, tb, td)
+    assert out["deflection_speed_mean"] == pytest.approx(30.0, rel=1e-3)   # a constant lag: the same speed
+    tb2 = np.where(sb <= 1.5, tb, np.inf)                                   # arrested at 1.5 m
+    out2 = pst_summary(scene, t, series, sb, tb2, td)
+    assert not out2["propagated"] and not out2["ran_to_end"]
+    assert out2["damage_front_final"] == pytest.approx(1.5, abs=0.02) and math.isnan(out2["speed"])
 
 
 def test_pst_summary_flags_a_crack_started_elsewhere():
-    scene, t, series, arrival = _synthetic_pst(c=150.0, reverse=True)
-    out = pst_summary(scene, t, series, arrival=arrival)
-    assert not out["initiated_at_saw"]
-    assert out["initiation_position"] > 4.5
-    assert out["apparent_speed"] == pytest.approx(150.0, rel=1e-6)
-    assert math.isnan(out["speed"])
+    scene, t, series, sb, tb, td = _synthetic_pst(c=150.0, reverse=True)
+    out = pst_summary(scene, t, series, sb, tb, td)
+    assert out["max_damage_lead"] > 4.0 and out["max_damage_lead_at"] > 5.0

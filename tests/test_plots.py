@@ -15,6 +15,7 @@ from mpm_warp.cli import main
 from mpm_warp.errors import InvalidArgument
 from mpm_warp.io import RunWriter, read_run
 from mpm_warp.post import fronts, plots
+from mpm_warp.scenes.pst import PSTParams
 
 T = np.linspace(0.0, 0.2, 41)                       # s, frames every 5 ms
 C, T0, CUT, END = 25.0, 0.05, 0.3, 3.0              # front speed [m/s], start [s], saw cut and column end [m]
@@ -112,23 +113,25 @@ def test_pst_series_names_and_fit_window(tmp_path):
     """A PST run stores ``front``/``saw`` (from the saw's end) and ``marker<k>_ux|uy``."""
     data = series()
     with RunWriter(tmp_path / "pst.h5", n_particles=1, particle_fields={"x": ((3,), "float64", "m")},
-                   scalar_series={"front": "m", "failure_front": "m", "saw": "m", "marker0_ux": "m",
+                   scalar_series={"front": "m", "deflection_front": "m", "saw": "m", "marker0_ux": "m",
                                   "marker0_uy": "m", "marker1_ux": "m", "marker1_uy": "m"},
                    attrs={"scenario": {"name": "pst", "scene": {"kind": "pst", "length": END,
                                                                 "saw": {"cut_length": CUT}}}}) as w:
         for k, t in enumerate(T):
             f = np.nan_to_num(data["front_position"][k])
             w.write_frame(t, k, {"x": np.zeros((1, 3))},
-                          scalars={"front": f, "failure_front": f, "saw": data["saw_position"][k],
+                          scalars={"front": f, "deflection_front": f, "saw": data["saw_position"][k],
                                    "marker0_ux": data["marker_0_dx"][k], "marker0_uy": data["marker_0_dy"][k],
                                    "marker1_ux": data["marker_1_dx"][k], "marker1_uy": data["marker_1_dy"][k]})
     names = [os.path.basename(f) for f in plots.plot_run(tmp_path / "pst.h5", tmp_path)]
     assert names == ["front.png", "front.csv", "front.json", "markers.png", "markers.csv"]
     fit = json.loads((tmp_path / "front.json").read_text())
     assert fit["series"] == "front" and fit["speed"] == pytest.approx(C, rel=1e-9)
-    assert fit["window"] == pytest.approx([CUT + 0.3 * (END - CUT), CUT + 0.85 * (END - CUT)])  # as pst.py
+    # the positions of the PST's own mean speed: from a bin beyond the cut over 3 m, at most to the end zone
+    bw = PSTParams().bin_width
+    assert fit["window"] == pytest.approx([CUT + bw, min(CUT + 3.0, END - max(PSTParams().slab_thickness, 2 * bw))])
     front = read_csv(tmp_path / "front.csv")
-    assert list(front) == ["time [s]", "front [m]", "failure_front [m]", "saw [m]", "front_fit [m]"]
+    assert list(front) == ["time [s]", "front [m]", "deflection_front [m]", "saw [m]", "front_fit [m]"]
     markers = read_csv(tmp_path / "markers.csv")
     np.testing.assert_array_equal(markers["marker1_uy [m]"], data["marker_1_dy"])
 

@@ -9,6 +9,7 @@ import time
 import numpy as np
 import pytest
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
+from helpers_scenes import TINY_PST, assert_same_series
 
 import mpm_warp as mw
 from mpm_warp import io
@@ -84,10 +85,8 @@ def test_cli_interrupted_by_signal_keeps_frames_and_resumes(tmp_path):
 
 
 # ------------------------------------------------------------------ scenes: the monitors' state is checkpointed
-#: a small PST (0.6 m column, 3.8k particles): settled by 0.04 s, sawn from then on, run to 0.08 s
-TINY_PST = ["scene.length=0.6", "scene.slab_thickness=0.15", "scene.saw.cut_length=0.15",
-            "scene.settle.gravity_ramp=0.02", "scene.settle.duration=0.04", "time.end=0.08",
-            "time.frame_interval=0.005", "output.checkpoint_every=1"]
+#: a small PST (0.6 m column, 3.6k particles): settled by 0.04 s, sawn from then on, run to 0.08 s
+PST = TINY_PST + ["time.end=0.08", "output.checkpoint_every=1"]
 #: a small shear test (560 particles): settled by 0.05 s, pushed from then on, run to 0.09 s
 TINY_SHEAR = ["scene.dx=0.01", "scene.sample_length=0.1", "scene.settle.gravity_ramp=0.03",
               "scene.settle.duration=0.05", "time.end=0.09", "time.frame_interval=0.005",
@@ -123,20 +122,23 @@ def _interrupted_equals_uninterrupted(tmp_path, scene: str, overrides: list, t_s
     assert a.scalars.keys() == b.scalars.keys()
     for n in a.scalars:
         np.testing.assert_array_equal(a.scalars[n], b.scalars[n], err_msg=n)
-    assert full.monitor.times == res.monitor.times and full.monitor.series == res.monitor.series
+    assert full.monitor.times == res.monitor.times
+    assert_same_series(full.monitor.series, res.monitor.series)
     _same_result(full.scene_result, res.scene_result)
     return full, res, arrays
 
 
 def test_pst_interrupted_after_settling_resumes_bit_for_bit(tmp_path):
-    full, res, arrays = _interrupted_equals_uninterrupted(tmp_path, "pst_demo", TINY_PST, 0.055,
-                                                          ["weak_layer/ref", "weak_layer/failed", "arrival"])
+    full, res, arrays = _interrupted_equals_uninterrupted(
+        tmp_path, "pst_demo", PST, 0.055, ["weak_layer/ref", "weak_layer/sawn", "weak_layer/arrival", "base_y_ref",
+                                           "base_arrival"])
     ck = "monitors/pst/device/"
-    assert (arrays[ck + "weak_layer/failed"] == 2).any()            # sawn particles at the stop
-    assert np.isfinite(arrays[ck + "arrival"]).any()                 # and front arrival times
+    assert (arrays[ck + "weak_layer/sawn"] == 1).any()              # sawn particles at the stop
+    assert np.isfinite(arrays[ck + "weak_layer/arrival"]).any()      # and damage times
     assert len(arrays["monitors/pst/series/times"]) == 12            # frames 0..11 recorded before the stop
-    np.testing.assert_array_equal(full.monitor.arrival.numpy(), res.monitor.arrival.numpy())
+    np.testing.assert_array_equal(full.monitor.weak.arrival.numpy(), res.monitor.weak.arrival.numpy())
     np.testing.assert_array_equal(full.monitor.weak.ref.numpy(), res.monitor.weak.ref.numpy())
+    np.testing.assert_array_equal(full.monitor.base_arrival.numpy(), res.monitor.base_arrival.numpy())
 
 
 def test_shear_test_interrupted_while_pushing_resumes_bit_for_bit(tmp_path):

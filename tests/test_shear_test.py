@@ -1,4 +1,11 @@
-"""Shear test of the weak layer (SI Note 2): scene builder and a coarse run with peak and softening."""
+"""Shear test of the weak layer (SI Note 2, issue 10): layout, and runs at 4 and 8 cells across the layer.
+
+Checks: peak within 10 % of the given shear strength, softening slip 2 +/- 0.5 mm for the SI's
+2 mm, residual below the peak, collapse beside the critical-state law, and peak and softening
+within 5 % between 4 and 8 cells through the layer.
+"""
+
+import math
 
 import numpy as np
 import pytest
@@ -18,12 +25,13 @@ def test_shear_test_layout():
     sigma_n = 250.0 * G * 0.5
     assert s.sigma_n == pytest.approx(sigma_n)
     assert sc.materials["load"].density == pytest.approx(sigma_n / (G * s.load_thickness))
-    assert sc.materials["weak_layer"].p0_ini == pytest.approx(3.0 * sigma_n)
+    assert sc.materials["weak_layer"] == s.calibrated().material
+    assert s.weak_layer.delta_s == 0.002 and s.weak_layer.tau_p == 1000.0   # the SI's case
     blocks = {b.name: b for b in sc.blocks}
     assert blocks["weak_layer"].hi[:2] == pytest.approx((s.sample_length, s.weak_layer_thickness))
     assert blocks["load"].lo[1] == pytest.approx(s.weak_layer_thickness)
     assert blocks["load"].hi[0] == pytest.approx(s.sample_length)
-    (floor,) = sc.walls  # the push is a device action on the loading block, not a wall
+    (floor,) = sc.walls  # the push is a device action on the loading plate, not a wall
     assert floor.kind == "sticky"
     assert s.push_start == s.settle.duration
 
@@ -33,35 +41,43 @@ def test_shear_test_bad_input():
         load_scenario("shear_test", ["scene.wall_sped=0.1"])
 
 
-#: coarse shear test: 1 cm grid (2 cells across the layer), 3 mm of push, 0.4 s
-COARSE = ["scene.dx=0.01", "time.end=0.4", "time.frame_interval=0.001"]
+def _run(cells: int):
+    sc = load_scenario("shear_test")
+    dx = sc.scene.weak_layer_thickness / cells
+    # 3.2 mm of push: past the peak (~0.1 mm) and the softening (~2 mm of the layer's slip, ~2.7 mm of the
+    # plate's) into the collapse and the residual
+    res = mw.run("shear_test", device=DEVICE, n_threads=1,
+                 overrides=[f"scene.dx={dx!r}", "time.end=0.42", "time.frame_interval=0.001"])
+    return res
 
 
-def test_shear_test_peak_then_softening():
-    res = mw.run("shear_test", device=DEVICE, overrides=COARSE, n_threads=1)
-    mon = res.monitor
-    series = {k: np.asarray(v) for k, v in mon.series.items()}
-    c = shear_curves(mon.params, mon.times, series)
+@pytest.fixture(scope="module")
+def runs():
+    return {n: _run(n) for n in (4, 8)}
+
+
+@pytest.mark.parametrize("cells", [4, 8])
+def test_shear_test_peak_softening_collapse(runs, cells):
+    res = runs[cells]
     ex = res.scene_result
-    n0 = len(mon.times) - len(c["tau"])
-    failed = series["failed_fraction"][n0:]
-    assert failed[0] == 0.0  # at rest under the slab's load the layer is intact
-    ip = int(np.argmax(c["tau"]))
-    assert 0 < ip < len(c["tau"]) - 5
-    # peak: elastic loading up to a strength of the order of the normal load (Cam-Clay, M = 1.2)
-    assert 100.0 < ex["peak_shear_stress"] < 2.0 * ex["sigma_n"]
-    assert failed[ip] < 0.5
-    # softening: the stress falls well below the peak afterwards, the layer fails and collapses
-    assert c["tau"][ip:].min() < 0.5 * ex["peak_shear_stress"]
-    assert ex["residual_shear_stress"] < ex["peak_shear_stress"]
-    assert failed[-1] > 0.9
-    # collapse: about the hardening law's value under sigma_n (20 %), SI Note 2 reports ~20 %
-    assert ex["collapse_fraction"] == pytest.approx(ex["collapse_fraction_law"], abs=0.06)
-    assert np.isfinite(ex["softening_displacement"]) and ex["softening_displacement"] > 0.0
-    # displacement control: the block moves at the push speed once the push has started
-    u = c["u"]
-    assert u[-1] == pytest.approx(0.01 * (c["t"][-1] - c["t"][0]), rel=0.05)
-    # the layer's own mean shear stress is lower (free ends, grid coupling of the driven top) but of that order
-    late = c["t"] > c["t"][-1] - 0.1
-    layer = series["layer_shear_stress"][n0:]
-    assert 0.4 * np.mean(c["tau"][late]) < np.mean(layer[late]) < np.mean(c["tau"][late])
+    mon = res.monitor
+    c = shear_curves(mon.params, mon.times, {k: np.asarray(v) for k, v in mon.series.items()})
+    assert c["bond"][0] > 0.999                        # intact under the slab's load when the push starts
+    # peak at the given strength (the calibration's material-point peak is within 1 % of it)
+    assert ex["peak_shear_stress"] == pytest.approx(ex["tau_p_calibrated"], rel=0.10)
+    # softening over the SI's ~2 mm of slip (the layer's own slip, top row against bottom row)
+    assert ex["bond_lost"] and ex["softening_displacement"] == pytest.approx(0.002, abs=0.0005)
+    assert ex["residual_shear_stress"] < 0.8 * ex["peak_shear_stress"]
+    # collapse beside the laws: more than the oedometric law (q = 0), as sheared snow compacts towards the critical
+    # state (p0 = 2 p): 0.23 / 0.25 here at 3.2 mm of push against 0.33 / 0.35 at that pressure (the full 8 mm
+    # of benchmarks/snow_shear.py: 0.27 / 0.29 against 0.24 / 0.25 at its final pressure)
+    assert ex["collapse_fraction_law"] < ex["collapse_fraction"] < ex["collapse_fraction_critical_state"] + 0.02
+    # displacement control: the plate moves at the push speed once the push has started
+    assert c["u"][-1] == pytest.approx(0.01 * (c["t"][-1] - c["t"][0]), rel=0.05)
+
+
+def test_shear_test_converges_across_4_and_8_cells(runs):
+    a, b = runs[4].scene_result, runs[8].scene_result
+    assert a["peak_shear_stress"] == pytest.approx(b["peak_shear_stress"], rel=0.05)
+    assert a["softening_displacement"] == pytest.approx(b["softening_displacement"], rel=0.05)
+    assert math.isfinite(a["w_f_calibrated"]) and a["w_f_calibrated"] > 0

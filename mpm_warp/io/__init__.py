@@ -2,14 +2,27 @@
 
 - :mod:`mpm_warp.io.runfile`: :class:`RunWriter` and the file layout (crash safety);
 - :mod:`mpm_warp.io.rundata`: :class:`RunData`, :func:`read_run`;
-- :mod:`mpm_warp.io.checkpoint`: :func:`write_checkpoint`, :func:`read_checkpoint`, :func:`checkpoint_path_for`;
+- :mod:`mpm_warp.io.checkpoint`: :func:`write_checkpoint`, :func:`read_checkpoint` (SHA-256 verified),
+  :func:`checkpoint_path_for`;
+- :mod:`mpm_warp.io.opening`: :func:`open_read`, which never hangs on a damaged file;
+- :mod:`mpm_warp.io.lock`: :func:`output_lock`, one writer per run file;
+- :mod:`mpm_warp.io.paths`: :func:`check_output_file`, :func:`check_output_dir`: what may be written;
 - :mod:`mpm_warp.io.hdf5`: format names and the helpers they share.
 """
 
-from .checkpoint import checkpoint_path_for, read_checkpoint, read_checkpoint_meta, write_checkpoint
+from .checkpoint import (
+    checkpoint_is_intact,
+    checkpoint_path_for,
+    read_checkpoint,
+    read_checkpoint_meta,
+    write_checkpoint,
+)
 from .hdf5 import CHECKPOINT_FORMAT, FORMAT, FORMAT_VERSION
+from .lock import is_live, output_lock
+from .paths import check_output_dir, check_output_file
 from .rundata import RunData, read_run
 from .runfile import RunWriter
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "RunWriter", "RunData", "read_run",
-           "write_checkpoint", "read_checkpoint", "read_checkpoint_meta", "checkpoint_path_for"]
+           "write_checkpoint", "read_checkpoint", "read_checkpoint_meta", "checkpoint_path_for",
+           "checkpoint_is_intact", "output_lock", "is_live", "check_output_file", "check_output_dir"]

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import datetime
 import json
-import os
 
 import h5py
 import numpy as np
 
 from ..errors import InvalidArgument, OutputError
+from .opening import DamagedFile, open_read
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "now", "to_json", "set_attrs", "get_attrs", "open_read",
            "check_format", "series_datasets", "layout", "check_name", "LIBVER", "SERIES_CHUNK",
@@ -55,17 +55,6 @@ def get_attrs(obj) -> dict:
     return out
 
 
-def open_read(path) -> h5py.File:
-    """Open a run or checkpoint read-only; ``swmr=True`` also opens files whose writer died."""
-    path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise OutputError(f"{path}: no such file")
-    try:
-        return h5py.File(path, "r", swmr=True)
-    except OSError as e:
-        raise OutputError(f"{path}: not a readable HDF5 file ({e})") from e
-
-
 def check_format(f: h5py.File, expected: str) -> None:
     fmt, version = f.attrs.get("format"), f.attrs.get("format_version")
     if fmt != expected:
@@ -77,11 +66,17 @@ def check_format(f: h5py.File, expected: str) -> None:
 
 def series_datasets(f: h5py.File) -> list[h5py.Dataset]:
     """Every per-frame dataset, in the order they are written (``time`` last)."""
+    for name in ("particles", "scalars", "step", "time"):
+        if name not in f:
+            raise OutputError(f"{f.filename}: incomplete run file (no /{name})")
     try:
         out = [*f["particles"].values(), *f["scalars"].values()]
-        return out + ([f["walls/forces"]] if "walls/forces" in f else []) + [f["step"], f["time"]]
-    except KeyError as e:
-        raise OutputError(f"{f.filename}: incomplete run file ({e})") from e
+        out += ([f["walls/forces"]] if "walls/forces" in f else []) + [f["step"], f["time"]]
+    except KeyError as e:                         # the link exists, its object header does not read
+        raise DamagedFile(f"{f.filename}: damaged ({e.args[0] if e.args else e})") from None
+    if any(d is None for d in out):               # h5py's answer for an object whose header cannot be read
+        raise DamagedFile(f"{f.filename}: damaged (the header of a per-frame dataset cannot be read)")
+    return out
 
 
 def layout(f: h5py.File) -> tuple:

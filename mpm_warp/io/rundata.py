@@ -8,7 +8,8 @@ import os
 import numpy as np
 
 from ..errors import InvalidArgument
-from .hdf5 import FORMAT, check_format, get_attrs, open_read, series_datasets
+from .hdf5 import FORMAT, check_format, get_attrs, series_datasets
+from .opening import open_read, reading
 
 __all__ = ["RunData", "read_run"]
 
@@ -39,7 +40,8 @@ class RunData:
 
     def __init__(self, path):
         self.path = os.fspath(path)
-        with open_read(self.path) as f:
+        with open_read(self.path) as f, reading(self.path, "reading its layout and series"):
+            self._swmr = f.swmr_mode      # later reads open the file the same way, without a new probe
             check_format(f, FORMAT)
             n = self.n_frames = min(d.shape[0] for d in series_datasets(f))
             self.attrs = get_attrs(f)
@@ -68,20 +70,21 @@ class RunData:
                 import tomllib
             except ImportError:  # Python 3.10
                 import tomli as tomllib
-            return tomllib.loads(s)
+            with reading(self.path, "its scenario attribute"):
+                return tomllib.loads(s)
 
     def frame(self, i: int) -> dict[str, np.ndarray]:
         """Particle fields of complete frame ``i`` (negative counts from the end)."""
         if not -self.n_frames <= i < self.n_frames:
             raise InvalidArgument("frame", i, f"an index in [{-self.n_frames}, {self.n_frames})")
-        with open_read(self.path) as f:
+        with open_read(self.path, self._swmr, probed=True) as f, reading(self.path, f"frame {i}"):
             return {k: f[f"particles/{k}"][i % self.n_frames] for k in self.particle_fields}
 
     def field(self, name: str) -> np.ndarray:
         """One particle field over all complete frames, ``(n_frames, N, *shape)``."""
         if name not in self.particle_fields:
             raise InvalidArgument("field", name, f"one of {self.particle_fields}")
-        with open_read(self.path) as f:
+        with open_read(self.path, self._swmr, probed=True) as f, reading(self.path, f"field {name}"):
             return f[f"particles/{name}"][: self.n_frames]
 
     def __repr__(self) -> str:
@@ -90,5 +93,8 @@ class RunData:
 
 
 def read_run(path) -> RunData:
-    """Read a run file (also one whose writer was killed); raises :class:`OutputError`."""
+    """Read a run file (also one being written, or whose writer was killed); raises :class:`OutputError`.
+
+    A damaged file (flipped or missing bytes) raises at once, never hangs (:mod:`mpm_warp.io.opening`).
+    """
     return RunData(path)

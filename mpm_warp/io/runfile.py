@@ -12,9 +12,11 @@ Run file layout (``format = "mpm_warp-run"``, ``format_version = 1``)::
     /walls/forces        (n_frames, n_walls, 3) float64 [N]; attr ``names`` (JSON list)
     /scalars/<name>      (n_frames,) float64, e.g. kinetic and elastic energy [J]
 
-Every dataset has a ``unit`` attribute. Compression of particle data: ``"gzip"`` = shuffle +
-gzip level 1 (any HDF5 tool reads it; level 4 was no smaller and 10-30 % slower), ``"lzf"`` =
-shuffle + LZF (about 3.5x faster to write, ~10 % larger, an h5py-only filter), ``"none"``.
+Every dataset has a ``unit`` attribute and the Fletcher-32 checksum filter of HDF5 (a flipped
+byte in any frame fails its read instead of giving a wrong number). Compression of particle
+data: ``"gzip"`` = shuffle + gzip level 1 (any HDF5 tool reads it; level 4 was no smaller and
+10-30 % slower), ``"lzf"`` = shuffle + LZF (about 3.5x faster to write, ~10 % larger, an
+h5py-only filter), ``"none"``.
 
 Crash safety: a frame is written whole or not at all
 ----------------------------------------------------
@@ -27,11 +29,13 @@ readers take ``n_frames = min(lengths)``, so a kill between two dataset headers,
 exception between two datasets, never shows a partial frame. A file is never touched outside
 SWMR mode: it is built aside (``<path>.part``), switched to SWMR, then renamed over ``path``.
 A killed writer (SIGKILL, default SIGTERM, OOM) leaves the superblock marked "open for write",
-which plain HDF5 refuses ("use h5clear"); :func:`read_run` opens with ``swmr=True``, which reads
-it (and runs still being written). SIGINT raises ``KeyboardInterrupt`` between HDF5 calls and
-``__exit__`` closes the file cleanly. :meth:`RunWriter.reopen` (resume) copies the kept frames
-chunk by chunk (raw bytes, no recompression) into a rebuilt file that replaces the old one, so a
-kill during resume leaves the old file or the new one. Verified by killing a writer (strace
+which plain HDF5 refuses ("use h5clear"); :func:`read_run` then opens it with ``swmr=True``
+(as it does runs still being written), after a time-boxed probe (:mod:`mpm_warp.io.opening`:
+an SWMR open of a damaged file would never return). SIGINT raises ``KeyboardInterrupt``
+between HDF5 calls and ``__exit__`` closes the file cleanly. :meth:`RunWriter.reopen` (resume)
+reads every kept frame once (a damaged one stops the resume) and copies them chunk by chunk
+(raw bytes, no recompression) into a rebuilt file that replaces the old one, so a kill during
+resume leaves the old file or the new one. Verified by killing a writer (strace
 fault injection) at every one of its ``pwrite`` calls. Protected: death of the process. Not
 protected: power loss (no fsync per frame), network file systems (no SWMR write ordering).
 """
@@ -61,6 +65,7 @@ from .hdf5 import (
     series_datasets,
     set_attrs,
 )
+from .opening import reading
 
 __all__ = ["RunWriter"]
 
@@ -94,6 +99,9 @@ class RunWriter:
         compression and the attributes already stored are kept).
     keep_frames : int, optional
         With ``append``: complete frames kept (default all), e.g. those of the checkpoint resumed.
+    verify : bool
+        With ``append``: read (decompress, checksum) every kept frame before copying it; a damaged one
+        raises :class:`OutputError` and leaves the file as it was. False when the caller read them already.
     """
 
     def __init__(self, path, *, n_particles: int,
@@ -101,8 +109,8 @@ class RunWriter:
                  static_fields: dict[str, tuple[np.ndarray, str]] | None = None,
                  wall_names=(), scalar_series: dict[str, str] | None = None,
                  attrs: dict | None = None, compression: str = "gzip", overwrite: bool = True,
-                 append: bool = False, keep_frames: int | None = None):
-        self.path, self._f = os.fspath(path), None
+                 append: bool = False, keep_frames: int | None = None, verify: bool = True):
+        self.path, self._f, self._verify = os.fspath(path), None, verify
         if not isinstance(n_particles, (int, np.integer)) or n_particles < 1:
             raise InvalidArgument("n_particles", n_particles, "an integer >= 1")
         if compression not in COMPRESSION:
@@ -147,17 +155,19 @@ class RunWriter:
         self._datasets = {d.name.lstrip("/"): d for d in series_datasets(self._f)}
 
     @classmethod
-    def reopen(cls, path, *, keep_frames: int | None = None, attrs: dict | None = None) -> RunWriter:
+    def reopen(cls, path, *, keep_frames: int | None = None, attrs: dict | None = None,
+               verify: bool = True) -> RunWriter:
         """Reopen a run (also one whose writer was killed) to append frames, e.g. to resume it.
 
         The layout is read from the file; ``keep_frames`` complete frames are kept (all if
-        None); ``attrs`` are added to the stored attributes.
+        None) and, with ``verify``, read once (a damaged one raises); ``attrs`` are added to the
+        stored attributes.
         """
         with open_read(path) as f:
             check_format(f, FORMAT)
             n_particles, fields, walls, scalars = layout(f)
         return cls(path, n_particles=n_particles, particle_fields=fields, wall_names=walls,
-                   scalar_series=scalars, attrs=attrs, append=True, keep_frames=keep_frames)
+                   scalar_series=scalars, attrs=attrs, append=True, keep_frames=keep_frames, verify=verify)
 
     def _resume(self, keep_frames, attrs) -> h5py.File:
         expected = (self.n_particles, {k: (s, d.str, u) for k, (s, d, u) in self._fields.items()},
@@ -174,7 +184,8 @@ class RunWriter:
             old = get_attrs(src)
             resumed = old.pop("resumed", []) + [{"at": now(), "kept_frames": int(keep)}]
             attrs = {k: v for k, v in old.items() if k not in RESERVED_ATTRS} | attrs
-            static = {k: (d[()], d.attrs["unit"]) for k, d in src["static"].items()}
+            with reading(self.path, "its static fields"):
+                static = {k: (d[()], d.attrs["unit"]) for k, d in src["static"].items()}
             first = next(iter(src["particles"].values()), None)
             compression = {"gzip": "gzip", "lzf": "lzf"}.get(getattr(first, "compression", 0), "none")
             f = self._build(static, {**attrs, "resumed": resumed}, compression, src, int(keep))
@@ -197,18 +208,24 @@ class RunWriter:
 
             def series(name, dtype, unit, shape=(), chunk=SERIES_CHUNK, **kw):
                 d = f.create_dataset(name, shape=(keep, *shape), maxshape=(None, *shape), dtype=dtype,
-                                     chunks=(chunk, *shape), **kw)
+                                     chunks=(chunk, *shape), fletcher32=True, **kw)
                 d.attrs["unit"] = unit
-                if src and keep and chunk == 1 and src[name].chunks == d.chunks and \
-                        (src[name].compression, src[name].shuffle) == (d.compression, d.shuffle):
-                    for i in range(src[name].id.get_num_chunks()):   # copy compressed bytes as is
-                        info = src[name].id.get_chunk_info(i)
-                        if info.chunk_offset[0] < keep:
-                            raw = src[name].id.read_direct_chunk(info.chunk_offset)[1]
-                            d.id.write_direct_chunk(info.chunk_offset, raw, info.filter_mask)
-                elif src and keep:
-                    for i in range(0, keep, chunk):
-                        d[i:i + chunk] = src[name][i:min(i + chunk, keep)]
+                if not (src and keep):
+                    return d
+                s = src[name]
+                with reading(self.path, f"{name}, in the {keep} frames the resume keeps"):
+                    if chunk == 1 and s.chunks == d.chunks and \
+                            (s.compression, s.shuffle, s.fletcher32) == (d.compression, d.shuffle, d.fletcher32):
+                        for i in range(s.id.get_num_chunks()):   # copy compressed bytes as is, once verified
+                            info = s.id.get_chunk_info(i)
+                            if info.chunk_offset[0] < keep:
+                                if self._verify:
+                                    s[info.chunk_offset[0]]          # decompress: the checksum is checked
+                                raw = s.id.read_direct_chunk(info.chunk_offset)[1]
+                                d.id.write_direct_chunk(info.chunk_offset, raw, info.filter_mask)
+                    else:
+                        for i in range(0, keep, chunk):
+                            d[i:i + chunk] = s[i:min(i + chunk, keep)]
                 return d
 
             series("time", "f8", "s")
@@ -218,7 +235,7 @@ class RunWriter:
                 series(f"particles/{name}", dtype, unit, (n, *shape), chunk=1, **filt)
             f.create_group("static", track_order=True)
             for name, (array, unit) in static.items():
-                f.create_dataset(f"static/{name}", data=array, **filt).attrs["unit"] = unit
+                f.create_dataset(f"static/{name}", data=array, fletcher32=True, **filt).attrs["unit"] = unit
             f.create_group("scalars", track_order=True)
             for name, unit in self._scalars.items():
                 series(f"scalars/{name}", "f8", unit)

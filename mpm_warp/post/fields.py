@@ -17,11 +17,10 @@ name               definition                                   unit   reference
 =================  ===========================================  =====  ====================================
 
 The collapse of the weak layer is measured from its settled state, not from ``log_jp = 0``: the
-initial consolidation (``log_jp(0) = -asinh(p0_ini/K)/xi``) is not a collapse, and the brittle
-failure rule resets ``log_jp`` (a hardening state, not a volume change), so ``1 - exp(log_jp)`` would
-show the intact layer as the most collapsed. The PST and shear-test monitors store ``log_jp_ref``
-per frame (it changes where particles fail); ``1 - exp(log_jp - log_jp_ref)`` is then the compaction behind the
-front that the front criterion of :mod:`mpm_warp.scenes.pst` uses.
+initial consolidation (``log_jp(0) = -asinh(p0_ini/K)/xi``) is not a collapse, so ``1 - exp(log_jp)``
+would show the intact, settled layer as collapsed. The PST and shear-test monitors store
+``log_jp_ref`` per frame (the layer's ``log_jp`` at the end of settling); ``1 - exp(log_jp -
+log_jp_ref)`` is then the compaction since settling, the collapse behind the crack front.
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Crack fronts read from run files: the front as x per frame and the front-speed fit with the scene's window.
 
 The fit itself is :func:`mpm_warp.scenes.fronts.steady_speed` (its one home); a PST's window is
-:data:`mpm_warp.scenes.pst.PSTParams.SPEED_FIT_FRACTIONS` of the way from the cut to the far end,
-as the PST's own result uses.
+the positions the PST's own mean speed is taken over (from one bin beyond the cut over
+:data:`mpm_warp.scenes.pst.analysis.MEAN_SPEED_DISTANCE`, at most to the far end zone).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from ..io import RunData
 from ..loader import scene_params_from_dict
 from ..scenes.fronts import fit_window, steady_speed
 from ..scenes.pst import PSTParams
+from ..scenes.pst.analysis import MEAN_SPEED_DISTANCE, end_zone
 
 __all__ = ["scene_params", "front_name", "fit_front_speed", "front_speed", "front_and_saw_x"]
 
@@ -88,8 +89,9 @@ def front_speed(run: RunData) -> dict:
     t, xf = run.times, run.scalars[name]
     params = scene_params(run)
     if name == "front" and isinstance(params, PSTParams):
-        return fit_front_speed(t, xf, *PSTParams.SPEED_FIT_FRACTIONS, start=float(params.saw.cut_length),
-                               end=float(params.length))
+        start = float(params.saw.cut_length) + params.bin_width      # beyond the cut: the saw's own path left out
+        end = min(start - params.bin_width + MEAN_SPEED_DISTANCE, float(params.length) - end_zone(params))
+        return fit_front_speed(t, xf, 0.0, 1.0, start=start, end=max(end, start + params.bin_width))
     return fit_front_speed(t, xf)
 
 

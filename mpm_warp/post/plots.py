@@ -5,7 +5,7 @@ and, for fits, ``<name>.json``. Figures are made only for the series a run has:
 
 - ``front``: crack front position against time, with the speed of a straight-line fit on the
   steady part of its travel (``front_position``, x [m], or a PST's ``front``, distance from the
-  saw's starting end [m]; the saw's position and the failure front too when stored);
+  saw's starting end [m]; the saw's position and the slab-deflection front too when stored);
 - ``markers``: slab marker displacements ``marker_<k>_dx|dy`` (or ``marker<k>_ux|uy``) against time;
 - ``shear``: shear stress (and Mises stress q) and axial strain against shear strain
   (``shear_strain`` with ``shear_stress``, ``mises_q``, ``axial_strain``);
@@ -25,7 +25,9 @@ import re
 import numpy as np
 
 from ..io import RunData, read_run
-from .fronts import front_name, front_speed
+from ..scenes.pst import PSTParams
+from .fronts import front_name, front_speed, scene_params
+from .pst_picture import pst_picture
 
 __all__ = ["plot_run", "plot_front", "plot_markers", "plot_shear", "plot_energy"]
 
@@ -75,16 +77,16 @@ def plot_front(run: RunData, out_dir: str) -> list[str]:
     """Front position against time with the fitted speed: ``front.png``, ``.csv``, ``.json``.
 
     The front is ``front_position`` (x [m]) or a PST's ``front`` (distance from the saw's end
-    [m]; with ``failure_front`` and ``saw`` beside it). The fit is :func:`mpm_warp.post.fronts.front_speed`
-    (for a PST the window of the PST's own result: 30 % to 85 % of the way from the cut to the far end).
+    [m], the damage front; with ``deflection_front`` and ``saw`` beside it). The fit is
+    :func:`mpm_warp.post.fronts.front_speed` (for a PST over the positions of the PST's own mean speed).
     """
     name = front_name(run)
     t, xf = run.times, run.scalars[name]
     fit = front_speed(run)
     fig, (ax,) = _figure()
-    ax.plot(t, xf, "o-", ms=3, lw=1, color="C0", label="crack front")
+    ax.plot(t, xf, "o-", ms=3, lw=1, color="C0", label="crack front" if name == "front_position" else "damage front")
     columns = {"time [s]": t, f"{name} [{_unit(run, name)}]": xf}
-    for other, style, label in (("failure_front", ":", "failure front"), ("saw_position", "--", "saw"),
+    for other, style, label in (("deflection_front", ":", "slab-deflection front"), ("saw_position", "--", "saw"),
                                 ("saw", "--", "saw")):
         if other in run.scalars:
             ax.plot(t, run.scalars[other], style, color="0.4", label=label)
@@ -185,7 +187,9 @@ def plot_run(path, out_dir=None) -> list[str]:
     list of str
         ``front.*`` (with ``front_position`` or ``front``), ``markers.*`` (with ``marker_<k>_dx|dy`` or
         ``marker<k>_ux|uy``),
-        ``shear.*`` (with ``shear_strain``), ``energy.*`` (with ``*_energy`` series), in that order.
+        ``shear.*`` (with ``shear_strain``), ``energy.*`` (with ``*_energy`` series), ``pst.png`` (a PST run
+        with ``x``, ``log_jp`` and ``log_jp_ref``: :func:`mpm_warp.post.pst_picture.pst_picture` at the moment
+        the crack runs), in that order.
     """
     run = path if isinstance(path, RunData) else read_run(path)
     out_dir = os.fspath(out_dir) if out_dir is not None else os.path.splitext(run.path)[0] + "_plots"
@@ -199,4 +203,6 @@ def plot_run(path, out_dir=None) -> list[str]:
         files += plot_shear(run, out_dir)
     if any(n.endswith("_energy") for n in s):
         files += plot_energy(run, out_dir)
+    if isinstance(scene_params(run), PSTParams) and {"x", "log_jp", "log_jp_ref"} <= set(run.particle_fields):
+        files.append(pst_picture(run, os.path.join(out_dir, "pst.png")))
     return files

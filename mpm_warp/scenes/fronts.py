@@ -18,8 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["collapse_fraction", "front_position", "front_from_arrival", "fit_window", "LineFit", "steady_speed",
-           "arrival_speed", "touchdown_distance", "marker_displacements", "Bisection", "bisect_threshold",
-           "critical_cut_length", "line_fit"]
+           "arrival_speed", "front_trajectory", "speed_profile", "mean_speed", "lead_ahead_of_front",
+           "touchdown_distance", "marker_displacements", "Bisection", "bisect_threshold", "critical_cut_length",
+           "line_fit"]
 
 
 def collapse_fraction(log_jp, log_jp_ref) -> np.ndarray:
@@ -136,6 +137,73 @@ def arrival_speed(s, t_arrival, lo: float, hi: float) -> LineFit:
     a, b, r2, n = line_fit(s[m], t[m])
     speed = 1.0 / a if a and np.isfinite(a) and a > 0 else math.nan
     return LineFit(speed, b, r2, n, *_span(t[m]))
+
+
+def front_trajectory(s, t_arrival) -> tuple[np.ndarray, np.ndarray]:
+    """The contiguous front's path: the bins from the cut end and the times the front passed them.
+
+    A front passes bin ``k`` once every bin up to it has arrived, at ``max(t_arrival[:k + 1])`` (s);
+    returns the bin positions ``s`` (m) and those times up to the first bin not reached (the cumulative
+    maximum stops being finite there).
+    """
+    s = np.asarray(s, dtype=float)
+    T = np.maximum.accumulate(np.asarray(t_arrival, dtype=float))
+    n = int(np.argmax(~np.isfinite(T))) if not np.isfinite(T).all() else len(T)
+    return s[:n], T[:n]
+
+
+def speed_profile(s, T, window: float, start: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Local front speed (m/s) along its path ``(s, T)`` from :func:`front_trajectory`, from ``start`` (m) on.
+
+    A line ``T(s)`` is fitted over windows of ``window`` (m) sliding by half a window; the speed is
+    ``1 / slope``. Returns the window centres (m) and the speeds (nan where the fit is undefined).
+    """
+    s, T = np.asarray(s, dtype=float), np.asarray(T, dtype=float)
+    mids, speeds = [], []
+    a = float(start)
+    while len(s) and a + window <= s[-1] + 1e-12:
+        m = (s >= a) & (s <= a + window)
+        slope, _, _, n = line_fit(s[m], T[m])
+        mids.append(a + 0.5 * window)
+        speeds.append(1.0 / slope if n >= 3 and np.isfinite(slope) and slope > 0 else math.nan)
+        a += 0.5 * window
+    return np.asarray(mids), np.asarray(speeds)
+
+
+def mean_speed(s, T, s0: float, s1: float) -> float:
+    """Mean front speed (m/s) from ``s0`` to ``s1`` (m) on the path ``(s, T)``; nan if the front did not reach ``s1``.
+
+    Measured from the first station at or beyond ``s0`` (the bins before it, e.g. the saw's, do not
+    enter): ``(s1 - s_a) / (T(s1) - T(s_a))``, ``T(s1)`` interpolated.
+    """
+    s, T = np.asarray(s, dtype=float), np.asarray(T, dtype=float)
+    if not len(s) or s[-1] < s1 or s[0] > s0:
+        return math.nan
+    a = int(np.searchsorted(s, s0 - 1e-12))
+    if a >= len(s) or s[a] >= s1:
+        return math.nan
+    dt = float(np.interp(s1, s[a:], T[a:]) - T[a])
+    return (s1 - float(s[a])) / dt if dt > 0 else math.inf
+
+
+def lead_ahead_of_front(s, t_arrival) -> tuple[float, float]:
+    """How far ahead of the contiguous front a bin arrived: ``(largest lead (m), the bin's position (m))``.
+
+    For every arrived bin, the front's position at its arrival time is subtracted from its own. A
+    crack that starts at the saw and runs from there leads by a process zone at most; damage at the
+    far end before the front arrives shows as a lead of metres.
+    """
+    s, t = np.asarray(s, dtype=float), np.asarray(t_arrival, dtype=float)
+    sp, T = front_trajectory(s, t)
+    k = np.nonzero(np.isfinite(t))[0]
+    if not len(k):
+        return 0.0, math.nan
+    half = 0.5 * (s[1] - s[0]) if len(s) > 1 else 0.0
+    passed = np.searchsorted(T, t[k], side="right")           # bins the front had passed (T is non-decreasing)
+    front = np.where(passed > 0, sp[np.maximum(passed - 1, 0)] + half, 0.0)
+    lead = s[k] - front
+    j = int(np.argmax(lead))
+    return (float(lead[j]), float(s[k[j]])) if lead[j] > 0 else (0.0, math.nan)
 
 
 def touchdown_distance(s, w, front: float, w_collapsed: float | None = None, level: float = 0.95,

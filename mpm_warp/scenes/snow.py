@@ -1,9 +1,10 @@
 """Shared pieces of the snow scenes: slab, settling, the slab's load, the plane-strain box.
 
-Both snow scenes put a weak layer (:mod:`mpm_warp.scenes.weak_layer`) on a substratum at ``y = 0``
-under a load, settle it under ramped gravity and grid damping, then run the experiment. ``x`` runs
-along the column, ``y`` is normal to the bed, ``z`` across; a slope of angle ``theta`` is a rotated
-gravity ``g (sin theta, -cos theta, 0)`` (downslope is ``+x``).
+Both snow scenes put a weak layer (:mod:`mpm_warp.scenes.weak_layer`) on a substratum under a load,
+settle it under ramped gravity and grid damping, then run the experiment. ``x`` runs along the
+column, ``y`` is normal to the bed, ``z`` across; a slope of angle ``theta`` is a rotated gravity
+``g (sin theta, -cos theta)`` (downslope is ``+x``). Scenes are plane strain in true 2D by default
+(``width = 0``: masses, forces and energies per metre of depth); ``width > 0`` builds a free 3D column.
 """
 
 from __future__ import annotations
@@ -17,14 +18,15 @@ from ..errors import InvalidArgument
 from ..materials import Elastic
 
 __all__ = ["GRAVITY", "Slab", "Settle", "SETTLE_TIME_KEYS", "MIN_WEAK_LAYER_CELLS", "slab_normal_stress",
-           "oedometric_pressure", "slope_gravity", "settle_time", "plane_domain", "check_weak_layer_cells"]
+           "oedometric_pressure", "slope_gravity", "settle_time", "PlaneBox", "plane_domain", "check_weak_layer_cells"]
 
 GRAVITY = 9.81
 """Gravitational acceleration (m/s^2)."""
 
-#: the weak layer must span at least this many grid cells: thinner, the slab's B-spline stencil
-#: reaches the substratum's wall nodes and the slab rests partly on the wall through the grid
-MIN_WEAK_LAYER_CELLS = 2.0
+#: the weak layer must span at least this many grid cells: a particle's quadratic B-spline stencil reaches
+#: 1.5 cells away, so across 2 cells the slab's base and the substratum's top (or the bed's wall nodes)
+#: share grid nodes, and the slab rests partly on them through the grid instead of on the layer
+MIN_WEAK_LAYER_CELLS = 3.0
 #: ``[time]`` keys a snow scene sets itself (from its slope and :class:`Settle`)
 SETTLE_TIME_KEYS = ("gravity", "gravity_ramp", "damping", "damping_until")
 
@@ -98,10 +100,10 @@ def oedometric_pressure(sigma_n: float, nu: float) -> float:
     return sigma_n * (1.0 + nu) / (3.0 * (1.0 - nu))
 
 
-def slope_gravity(slope_deg: float) -> tuple[float, float, float]:
-    """Gravity (m/s^2) on a slope of ``slope_deg``: ``g (sin theta, -cos theta, 0)``, downslope ``+x``."""
+def slope_gravity(slope_deg: float, dim: int = 3) -> tuple[float, ...]:
+    """Gravity (m/s^2) on a slope of ``slope_deg``: ``g (sin theta, -cos theta[, 0])``, downslope ``+x``."""
     th = math.radians(slope_deg)
-    return (GRAVITY * math.sin(th), -GRAVITY * math.cos(th), 0.0)
+    return (GRAVITY * math.sin(th), -GRAVITY * math.cos(th), 0.0)[:dim]
 
 
 def settle_time(time: TimeControl, settle: Settle, gravity) -> TimeControl:
@@ -110,12 +112,43 @@ def settle_time(time: TimeControl, settle: Settle, gravity) -> TimeControl:
                    damping=float(settle.damping), damping_until=float(settle.duration))
 
 
-def plane_domain(lo_xy, hi_xy, dx: float, width: float, margin: float) -> tuple[Domain, float]:
-    """Domain and z extent (m): one cell between slip walls (``width = 0``, plane strain) or a free 3D column."""
+@dataclass(frozen=True)
+class PlaneBox:
+    """The box of a snow scene: true 2D plane strain (``width = 0``) or a free 3D column of that width.
+
+    Attributes
+    ----------
+    domain : Domain
+    dim : int
+        2 (plane strain in x-y) or 3.
+    depth : float
+        Extent of the particles in z (m; 1 m of depth in 2D, where masses and forces are per metre).
+    """
+
+    domain: Domain
+    dim: int
+    depth: float
+
+    def corner(self, x: float, y: float) -> tuple[float, ...]:
+        """A block corner at ``(x, y)`` (m): ``(x, y)`` in 2D, ``(x, y, 0)`` in 3D (the column starts at z = 0)."""
+        return (x, y) if self.dim == 2 else (x, y, 0.0)
+
+    def far_corner(self, x: float, y: float) -> tuple[float, ...]:
+        """The opposite block corner: ``(x, y)`` in 2D, ``(x, y, width)`` in 3D."""
+        return (x, y) if self.dim == 2 else (x, y, self.depth)
+
+    def vector(self, x: float, y: float) -> tuple[float, ...]:
+        """A point or direction in the scene's dimension (z = 0 in 3D)."""
+        return (x, y) if self.dim == 2 else (x, y, 0.0)
+
+
+def plane_domain(lo_xy, hi_xy, dx: float, width: float, margin: float) -> PlaneBox:
+    """The box: plane strain in true 2D (``width = 0``) or a free 3D column of ``width`` (m) with ``margin`` (m)
+    of free space on each side in z."""
     if width <= 0.0:
-        return Domain((lo_xy[0], lo_xy[1], 0.0), (hi_xy[0], hi_xy[1], dx), dx, boundary="slip",
-                      boundary_faces="z"), dx
-    return Domain((lo_xy[0], lo_xy[1], -margin), (hi_xy[0], hi_xy[1], width + margin), dx, boundary="none"), width
+        return PlaneBox(Domain(tuple(lo_xy), tuple(hi_xy), dx, boundary="none", dimension=2), 2, 1.0)
+    return PlaneBox(Domain((lo_xy[0], lo_xy[1], -margin), (hi_xy[0], hi_xy[1], width + margin), dx,
+                           boundary="none"), 3, float(width))
 
 
 def check_weak_layer_cells(d_wl: float, dx: float, where: str) -> None:

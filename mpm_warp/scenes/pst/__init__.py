@@ -1,51 +1,57 @@
 """Propagation Saw Test (PST): parameters, builder, saw, crack-front tracking (MODEL.md 6).
 
-A column of length ``L`` on a stiff substratum: a thin Cam-Clay weak layer (thickness ``D_wl``)
-bonded to the substratum (a wall at ``y = 0``) under an elastic slab (thickness ``D``). ``x`` runs
-along the column, ``y`` is normal to the bed, ``z`` across; a slope of angle ``theta`` is a rotated
-gravity ``g (sin theta, -cos theta, 0)`` (downslope is ``+x``). By default the column is one cell
-thin in ``z`` between slip walls (plane strain); ``width > 0`` gives a full 3D column with free sides.
+A column of length ``L``: elastic old snow (the substratum, ``D_sub``) bonded to the bed (a wall at
+``y = 0``), the weak layer (``D_wl``, the bonded Cam-Clay of :mod:`mpm_warp.scenes.weak_layer`,
+calibrated from its field quantities under this slab) and the elastic slab (``D``). ``x`` runs along
+the column, ``y`` is normal to the bed; a slope of angle ``theta`` is a rotated gravity
+``g (sin theta, -cos theta)`` (downslope is ``+x``). Plane strain in true 2D by default (``width =
+0``, quantities per metre of depth); ``width > 0`` gives a free 3D column.
 
 Run sequence (all on the device, no host loop):
 
 1. settling: gravity ramps up over ``settle.gravity_ramp`` while the grid is damped until
-   ``settle.duration``; the hardening state of the weak layer at the end of settling is the
-   collapse reference;
-2. the saw: from ``settle.duration`` on, a blade advances at ``saw.speed`` from one end of the column
-   through the weak layer up to ``saw.cut_length``; weak-layer particles behind the blade get
-   ``log_jp = saw.log_jp`` (a large positive value: ``p0`` sits at its floor and compaction cannot
-   re-harden them within any reachable strain), re-applied every step while behind it;
-3. free run: the crack runs by itself or arrests. The weak layer's failure rule (the brittle
-   first-yield rule by default) is in :mod:`mpm_warp.scenes.weak_layer`.
+   ``settle.duration``; the weak layer's hardening state and the slab base's position then are the
+   references of the collapse and of the deflection;
+2. the saw: from ``settle.duration`` on, a blade advances at ``saw.speed`` (at most 1 m/s) from one
+   end of the column through the weak layer up to ``saw.cut_length``; behind it the layer loses its
+   bond (a kerf), is cohesionless and collapses under the slab;
+3. free run: the crack runs by itself or arrests.
 
-Crack front (documented criterion): a weak-layer particle has *collapsed* once its plastic volume
-has shrunk by more than ``front.threshold`` relative to the reference state (the settled layer, or
-the state at failure), ``1 - exp(log_jp - log_jp_ref) >= threshold``, or once it has been sawn. The
-column is split into bins of ``front.bin`` along the cut direction; a bin's arrival time is the first
-time any of its particles collapsed (``atomic_min`` on the device, every step). The front at time
-``t`` is the far edge of the contiguous run of bins, from the saw's end, whose arrival time is
-``<= t`` (distance from the saw's starting end, m). The failure front (failed or sawn particles) is
-tracked the same way.
+Fronts (documented criteria, distances from the saw's end of the column, m; bins of ``front.bin``):
 
-Resolution: the weak layer must span at least two grid cells
-(:data:`~mpm_warp.scenes.snow.MIN_WEAK_LAYER_CELLS`); with one, the slab's B-spline stencil reaches
-the substratum's wall nodes and the slab rests partly on the wall.
+- damage front: a weak-layer particle is damaged once its bond ``1 - kappa/kappa_s`` has fallen to
+  one half; a bin once the median of its particles' damage times has passed; the front is the far
+  edge of the contiguous run of damaged bins from the cut end;
+- slab-deflection front: the same with the slab base's particles, damaged once the base has come
+  down by ``front.deflection`` (0.1) times the calibrated collapse height.
+
+Speeds are profiles along the fronts' paths, the touchdown distance is measured behind the
+deflection front, and the critical cut length comes from bisection on the saw's stop position
+(:func:`critical_cut`, trial runs forked from one base run) or, from one run, the saw position when the
+crack ran away from the blade (``runaway_cut``); :mod:`.analysis`.
+
+Resolution: the weak layer must span at least three grid cells
+(:data:`~mpm_warp.scenes.snow.MIN_WEAK_LAYER_CELLS`: the stencils of the slab and the substratum must not
+share a grid node); four resolve it (the ready scenes).
 
 Modules: :mod:`.params` (:class:`PSTParams` and its derived values), :mod:`.build`,
-:mod:`.kernels` (saw and front tracker), :mod:`.monitor` (:class:`PSTMonitor`), :mod:`.analysis`
-(:func:`pst_summary`), :mod:`.references` (Heierli, Gaume et al. 2017).
+:mod:`.kernels` (the deflection tracker; the saw is the weak layer's), :mod:`.monitor`
+(:class:`PSTMonitor`), :mod:`.analysis` (:func:`pst_summary`), :mod:`.critical` (:func:`critical_cut`:
+bisection over trial runs forked from one base run); the closed forms in
+:mod:`mpm_warp.scenes.references`.
 """
 
 from ..contract import SceneType
+from ..references import critical_cut_length_formula, heierli_speed, heierli_touchdown
 from ..snow import SETTLE_TIME_KEYS
 from .analysis import pst_summary
 from .build import build
+from .critical import CriticalCut, critical_cut
 from .monitor import PSTMonitor, attach
 from .params import Front, PSTParams, Saw
-from .references import critical_cut_length_formula, heierli_speed, heierli_touchdown
 
-__all__ = ["SCENE", "PSTParams", "Saw", "Front", "build", "attach", "PSTMonitor", "pst_summary", "heierli_speed",
-           "heierli_touchdown", "critical_cut_length_formula"]
+__all__ = ["SCENE", "PSTParams", "Saw", "Front", "build", "attach", "PSTMonitor", "pst_summary", "critical_cut",
+           "CriticalCut", "heierli_speed", "heierli_touchdown", "critical_cut_length_formula"]
 
 SCENE = SceneType(
     kind="pst", params=PSTParams, build=build, attach=attach, time_keys=SETTLE_TIME_KEYS,

@@ -1,4 +1,9 @@
-"""Results of a PST from its frame series (pure NumPy): crack speed, touchdown distance, collapse, initiation."""
+"""Results of a PST from its fronts and frame series (pure NumPy): speeds as profiles, touchdown, collapse.
+
+Everything is measured from the cut end (m) along the column, on the paths of the two fronts
+(:func:`~mpm_warp.scenes.fronts.front_trajectory`): the damage front (the weak layer's bond) and the
+slab-deflection front (the slab base coming down).
+"""
 
 from __future__ import annotations
 
@@ -6,26 +11,50 @@ import math
 
 import numpy as np
 
-from ..fronts import arrival_speed, line_fit, steady_speed, touchdown_distance
+from ..fronts import front_trajectory, lead_ahead_of_front, mean_speed, speed_profile
+from ..references import heierli_speed, heierli_touchdown
 from .params import PSTParams
 
-__all__ = ["pst_summary"]
+__all__ = ["pst_summary", "end_zone", "SPEED_WINDOW", "MEAN_SPEED_DISTANCE", "SPEED_LIMIT_DISTANCE"]
+
+#: window of the local front speed (m)
+SPEED_WINDOW = 0.5
+#: the mean front speed is taken over this distance from the cut (m)
+MEAN_SPEED_DISTANCE = 3.0
+#: the largest local speed is reported within this distance from the cut (m)
+SPEED_LIMIT_DISTANCE = 5.0
 
 
-def pst_summary(params: PSTParams, times, series: dict, arrival=None) -> dict:
-    """Crack speed, touchdown distance and collapse from PST frame series.
+def end_zone(params: PSTParams) -> float:
+    """Length of the far end zone (m): one slab thickness (at least two bins), whose free edge unloads the layer."""
+    return max(float(params.slab_thickness), 2.0 * params.bin_width)
 
-    Speed: least-squares line through the front positions (or the bin arrival
-    times when given) on the steady part, the middle of the self-propagation
-    path (:meth:`PSTParams.speed_fit_window`: from ``cut + 0.3 (L - cut)`` to ``cut + 0.85 (L - cut)``).
-    Touchdown: :func:`~mpm_warp.scenes.fronts.touchdown_distance` on the slab-base marker profiles at
-    the frames where the front lies in that window. Collapse: the last frame's
-    ``collapse_height``. Initiation (with ``arrival``): position and time of the
-    first collapse beyond the cut (``s > cut + 2 bins``); ``initiated_at_saw`` when
-    it lies within ``0.1 L`` of the cut (else the crack started elsewhere, e.g. at
-    the far end of the column, and ``apparent_speed`` = ``1 / |slope|`` of the
-    arrival times beyond the cut tells how fast it swept the column). The closed-form
-    references of :meth:`PSTParams.references` are copied in.
+
+def _front(params: PSTParams, s, t_arrival, prefix: str) -> dict:
+    cut, L = float(params.saw.cut_length), float(params.length)
+    sp, T = front_trajectory(s, t_arrival)
+    reach = float(sp[-1] + 0.5 * params.bin_width) if len(sp) else 0.0
+    mids, c = speed_profile(sp, T, SPEED_WINDOW, start=cut)
+    d1 = min(cut + MEAN_SPEED_DISTANCE, L - end_zone(params))
+    within = mids <= cut + SPEED_LIMIT_DISTANCE
+    return {f"{prefix}_front_final": min(reach, L),
+            f"{prefix}_speed_mean": mean_speed(sp, T, cut, d1),
+            f"{prefix}_speed_mean_over": [cut, d1],
+            f"{prefix}_speed_max": float(np.nanmax(c[within])) if np.isfinite(c[within]).any() else math.nan,
+            f"{prefix}_speed_profile": {"s": mids.tolist(), "speed": c.tolist()},
+            f"{prefix}_path": {"s": sp.tolist(), "t": T.tolist()}}
+
+
+def _runaway(params: PSTParams, s, t_arrival) -> float:
+    """Saw position (m) when the damage front first led the blade by ``front.runaway_lead``; nan if never."""
+    sp, T = front_trajectory(s, t_arrival)
+    saw = np.clip(params.saw.speed * (T - params.saw_start), 0.0, params.saw.cut_length)
+    k = np.nonzero(sp - saw >= params.front.runaway_lead)[0]
+    return float(saw[k[0]]) if len(k) else math.nan
+
+
+def pst_summary(params: PSTParams, times, series: dict, s_bins, t_damage, t_deflection) -> dict:
+    """Crack fronts, speeds, touchdown and collapse of a PST.
 
     Parameters
     ----------
@@ -33,56 +62,56 @@ def pst_summary(params: PSTParams, times, series: dict, arrival=None) -> dict:
     times : array (n,)
         Frame times (s).
     series : dict
-        ``front`` (m), ``collapse_height`` (m), ``marker{k}_uy`` (m) per frame.
-    arrival : (array, array), optional
-        Bin centres (m from the cut end) and their first-collapse times (s, inf = never).
+        Frame series of :class:`~mpm_warp.scenes.pst.PSTMonitor` (``front``, ``deflection_front``,
+        ``touchdown``, ``collapse_height``, ...).
+    s_bins : array
+        Bin centres (m from the cut end).
+    t_damage, t_deflection : array
+        Arrival time of the damage and deflection fronts in every bin (s, inf: never).
+
+    Returns
+    -------
+    dict
+        Per front (``damage_``/``deflection_``): ``front_final`` (m), ``speed_mean`` (m/s, from the cut
+        over :data:`MEAN_SPEED_DISTANCE` or to the end zone (:func:`end_zone`), nan if not reached),
+        ``speed_max`` (m/s, the largest local speed within :data:`SPEED_LIMIT_DISTANCE`), ``speed_profile`` (local
+        speeds over
+        :data:`SPEED_WINDOW` windows), ``path``. Then ``propagated`` (the damage front ran at least
+        2 m beyond the cut, or to the end zone: within one slab thickness of the far end, whose free edge
+        unloads the layer under it), ``ran_to_end`` (into the end zone), ``speed`` (the damage
+        front's mean speed), ``front_agreement`` (deflection over damage mean speed), ``runaway_cut``
+        (m: the saw position when the crack ran away from it, the one-run estimate of the critical
+        cut), ``max_damage_lead``/``max_damage_lead_at`` (m: how far ahead of the contiguous front a
+        bin was damaged, and where: the crack started at the saw when small), ``touchdown`` (m, the
+        median over the frames with the deflection front in the middle of its free run),
+        ``collapse_height`` (m, last frame) and the closed-form references of
+        :meth:`PSTParams.references` (with ``heierli_speed_run``/``heierli_touchdown_run``: Heierli's
+        values with the run's own collapse height).
     """
-    L = float(params.length)
-    cut = float(params.saw.cut_length)
-    lo, hi = params.speed_fit_window()
-    bin_w = params.bin_width
+    cut, L = float(params.saw.cut_length), float(params.length)
+    out = {"cut_length": cut, "column_length": L}
+    out.update(_front(params, s_bins, t_damage, "damage"))
+    out.update(_front(params, s_bins, t_deflection, "deflection"))
+    reach = out["damage_front_final"]
+    out["propagated"] = bool(reach >= min(cut + 2.0, L - end_zone(params)))
+    out["ran_to_end"] = bool(reach >= L - end_zone(params))
+    out["speed"] = out["damage_speed_mean"]
+    v1, v2 = out["damage_speed_mean"], out["deflection_speed_mean"]
+    out["front_agreement"] = v2 / v1 if np.isfinite(v1) and np.isfinite(v2) and v1 > 0 else math.nan
+    out["runaway_cut"] = _runaway(params, s_bins, t_damage)
+    out["max_damage_lead"], out["max_damage_lead_at"] = lead_ahead_of_front(s_bins, t_damage)
     t = np.asarray(times, dtype=float)
-    front = np.asarray(series["front"], dtype=float)
-    after = t >= params.saw_end
-    out = {"front_final": float(front[-1]) if len(front) else 0.0, "cut_length": cut, "column_length": L,
-           "propagated": bool(len(front) and front[-1] >= cut + 0.5 * (L - cut)),
-           "ran_to_end": bool(len(front) and front[-1] >= L - 2.0 * bin_w)}
-    fit = steady_speed(t[after], front[after], lo, hi)
-    out["speed_frames"] = fit.speed
-    if arrival is not None:
-        sb, tb = arrival
-        fit_b = arrival_speed(sb, tb, lo, hi)
-        out["speed_arrival"] = fit_b.speed
-        out["speed_arrival_r2"] = fit_b.r2
-        sb, tb = np.asarray(sb, dtype=float), np.asarray(tb, dtype=float)
-        beyond = (sb > cut + 2.0 * bin_w) & np.isfinite(tb)
-        if beyond.any():
-            k = int(np.argmin(np.where(beyond, tb, np.inf)))
-            out["initiation_position"] = float(sb[k])
-            out["initiation_time"] = float(tb[k])
-            out["initiated_at_saw"] = bool(sb[k] <= cut + 0.1 * L)
-            a, _, _, n = line_fit(sb[beyond], tb[beyond])
-            out["apparent_speed"] = abs(1.0 / a) if n >= 3 and np.isfinite(a) and a != 0 else math.nan
-        else:
-            out["initiated_at_saw"] = False
-    out["speed"] = out.get("speed_arrival", fit.speed)
-    out["speed_fit_window"] = [lo, hi]
+    df = np.asarray(series.get("deflection_front", np.zeros(len(t))), dtype=float)
+    td = np.asarray(series.get("touchdown", np.full(len(t), np.nan)), dtype=float)
+    steady = (df >= cut + 0.3 * (L - cut)) & (df <= cut + 0.85 * (L - cut)) & np.isfinite(td)
+    out["touchdown"] = float(np.median(td[steady])) if steady.any() else math.nan
     ch = np.asarray(series.get("collapse_height", [0.0]), dtype=float)
     out["collapse_height"] = float(ch[-1]) if len(ch) else 0.0
-    markers = params.markers()
-    uy = np.stack([np.asarray(series[f"marker{k}_uy"], dtype=float) for k in range(len(markers))], axis=1)
-    s_markers = params.distance_from_cut_end(markers)
-    i0 = min(int(np.searchsorted(t, params.saw_start)), len(t) - 1)
-    w = -(uy - uy[i0])  # downward deflection of the slab base since the saw started (m)
-    td = []
-    for i in np.nonzero((front >= lo) & (front <= hi))[0]:
-        val = touchdown_distance(s_markers, w[i], front[i], s_min=cut)
-        if np.isfinite(val):
-            td.append(val)
-    out["touchdown"] = float(np.median(td)) if td else float("nan")
-    out["slab_deflection_final"] = float(np.median(w[-1][s_markers < front[-1]])) if (s_markers < front[-1]).any() \
-        else 0.0
     refs = params.references()
-    for k in ("heierli_speed", "heierli_touchdown", "rayleigh_speed", "shear_wave_speed", "collapse_height_law"):
-        out[k] = float(refs[k])
+    out.update({k: float(v) for k, v in refs.items()})
+    slab = params.slab
+    h = out["collapse_height"]
+    out["heierli_speed_run"] = heierli_speed(slab.E, params.slab_thickness, slab.density, h) if h > 0 else math.nan
+    out["heierli_touchdown_run"] = heierli_touchdown(slab.E, params.slab_thickness, slab.density, h) \
+        if h > 0 else math.nan
     return out

@@ -1,17 +1,15 @@
-"""The PST monitor: the saw, the weak layer's failure rule, the crack-front trackers and the frame series."""
+"""The PST monitor: the saw, the damage and slab-deflection fronts, touchdown, and the frame series."""
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 import warp as wp
 
-from ..fronts import front_from_arrival
+from ..fronts import front_from_arrival, touchdown_distance
 from ..series import SeriesMonitor, entries_below
-from ..weak_layer import SAWN, ReferenceField, WeakLayerTracker
+from ..weak_layer import ReferenceField, WeakLayerTracker, bin_median
 from .analysis import pst_summary
-from .kernels import pst_action_kernel
+from .kernels import deflection_kernel
 from .params import PSTParams
 
 __all__ = ["PSTMonitor", "attach"]
@@ -20,13 +18,14 @@ __all__ = ["PSTMonitor", "attach"]
 class PSTMonitor(ReferenceField, SeriesMonitor):
     """The saw, the front trackers and the frame diagnostics of one PST simulation.
 
-    Frame scalars (stored in the run file): ``front`` (m from the cut end, the collapse criterion of
-    :mod:`mpm_warp.scenes.pst`), ``failure_front`` (m, the same with failed-or-sawn particles), ``saw``
-    (m), ``collapse_height`` (m, mean collapse times ``D_wl`` over failed, unsawn particles that
-    collapsed by more than the threshold), ``marker{k}_ux``/``marker{k}_uy`` (m, displacement since
-    t = 0 of the slab-base particle nearest to ``params.markers()[k]``). Per-frame particle field
-    (with ``log_jp`` in the output): ``log_jp_ref``, the collapse reference (see
-    :mod:`mpm_warp.post.fields`).
+    Fronts (distances from the cut end, m; see :mod:`mpm_warp.scenes.pst`): ``front`` (damage: bins
+    whose particles' median bond fell to one half), ``deflection_front`` (bins whose slab base came
+    down by ``front.deflection`` times the collapse height). Frame scalars (stored in the run file):
+    both fronts, ``saw`` (m), ``collapse_height`` (m: mean collapse of the debonded, unsawn layer times
+    ``D_wl``), ``touchdown`` (m behind the deflection front where the slab base reaches 95 % of its
+    collapsed deflection; nan before the crack runs), ``marker{k}_ux``/``marker{k}_uy`` (m,
+    displacement since t = 0 of the slab-base particle nearest to ``params.markers()[k]``).
+    Per-frame particle field (with ``log_jp`` in the output): ``log_jp_ref``, the collapse reference.
 
     Parameters
     ----------
@@ -44,45 +43,42 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         self.params = p
         self.sim = sim
         T = sim.model.T
-        self.direction = 1.0 if p.saw.from_end == "left" else -1.0
-        self.x_start = 0.0 if self.direction > 0 else float(p.length)
-        self.bin = p.bin_width
-        self.n_bins = p.n_bins
-        self.length = float(p.length)
-        self.t_start = p.saw_start
-        self.cut_length = float(p.saw.cut_length)
-        self.speed = float(p.saw.speed)
-        self.d_wl = float(p.weak_layer_thickness)
-        self.threshold = float(p.front.threshold)
-        self.weak = WeakLayerTracker(sim, "weak_layer", self.t_start, p.weak_layer)
-        wl = self.weak.group
-        self.arrival = wp.full(self.n_bins, np.inf, dtype=wp.float64, device=sim.device)
-        self.arrival_failure = wp.full(self.n_bins, np.inf, dtype=wp.float64, device=sim.device)
-        self.saw_action = wp.launch(
-            pst_action_kernel(T), wl.count,
-            inputs=[wl.x, self.weak.log_jp, self.weak.ref, self.weak.failed, sim.clock, self.t_start, self.x_start,
-                    self.direction, self.speed, self.cut_length, T(float(p.saw.log_jp)),
-                    T(math.log(1.0 - self.threshold)), self.bin, self.arrival, self.arrival_failure],
-            device=sim.device, record_cmd=True)
-        # slab-base markers: the particle of the lowest slab row nearest to each station (middle of z)
+        left = p.saw.from_end == "left"
+        saw = (p.saw_start, p.saw.speed, p.saw.cut_length, 0.0 if left else float(p.length), 1.0 if left else -1.0)
+        self.weak = WeakLayerTracker(sim, "weak_layer", p.saw_start, saw)
+        self.h_c = p.calibrated().h_c
+        self.s_weak = p.distance_from_cut_end(self.weak.group.x0[:, 0])
+        # the slab base: its lowest lattice row (all of it in z for the fronts)
         self.slab = sim.group_state("slab")
         x0 = self.slab.x0
-        base = x0[:, 1] <= x0[:, 1].min() + 1e-6
-        zmid = 0.5 * p.width_z
-        idx = np.nonzero(base)[0]
-        zc = idx[np.abs(x0[idx, 2] - zmid) <= np.abs(x0[idx, 2] - zmid).min() + 1e-6]
+        base = np.nonzero(x0[:, 1] <= x0[:, 1].min() + 1e-6)[0]
+        self.base_index = base
+        self.s_base = p.distance_from_cut_end(x0[base, 0])
+        dev = sim.device
+        self.base_y_ref = wp.array(x0[base, 1].astype(np.float64), dtype=wp.float64, device=dev)
+        self.base_arrival = wp.full(len(base), np.inf, dtype=wp.float64, device=dev)
+        self.deflection_action = wp.launch(
+            deflection_kernel(sim.model.dim, T), len(base),
+            inputs=[self.slab.x, wp.array(base.astype(np.int32), dtype=wp.int32, device=dev), self.base_y_ref,
+                    self.base_arrival, sim.clock, float(p.saw_start), float(p.front.deflection * self.h_c)],
+            device=dev, record_cmd=True)
         self.markers = p.markers()
-        #: index of each marker's particle within the slab group
-        self.marker_index = zc[np.argmin(np.abs(x0[zc, 0][None, :] - self.markers[:, None]), axis=1)]
+        #: index of each marker's particle within the slab group (the base row, nearest to the middle in z)
+        zsel = base
+        if x0.shape[1] == 3:
+            zmid = 0.5 * float(p.width)
+            dz = np.abs(x0[base, 2] - zmid)
+            zsel = base[dz <= dz.min() + 1e-6]
+        self.marker_index = zsel[np.argmin(np.abs(x0[zsel, 0][None, :] - self.markers[:, None]), axis=1)]
 
     # ----------------------------------------------------------------- contract
     def actions(self) -> list:
-        """The weak layer's failure rule, then the saw and front trackers, every step."""
-        return [self.weak.launch, self.saw_action]
+        """The saw and the weak layer's bookkeeping, then the deflection tracker, every step."""
+        return [self.weak.launch, self.deflection_action]
 
     def units(self) -> dict[str, str]:
         """Units of the frame scalars."""
-        u = {"front": "m", "failure_front": "m", "saw": "m", "collapse_height": "m"}
+        u = {"front": "m", "deflection_front": "m", "saw": "m", "collapse_height": "m", "touchdown": "m"}
         for k in range(len(self.markers)):
             u[f"marker{k}_ux"] = "m"
             u[f"marker{k}_uy"] = "m"
@@ -91,12 +87,18 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
     def measure(self, sim) -> dict[str, float]:
         """Frame scalars (see the class docstring)."""
         t = sim.time
-        out = {"front": min(front_from_arrival(self.arrival.numpy(), t, self.bin), self.length),
-               "failure_front": min(front_from_arrival(self.arrival_failure.numpy(), t, self.bin), self.length),
-               "saw": self.saw_position(t)}
-        c, flag = self.weak.collapse()
-        sel = (c >= self.threshold) & (flag != SAWN)
-        out["collapse_height"] = float(np.mean(c[sel]) * self.d_wl) if sel.any() else 0.0
+        p = self.params
+        bin_w = p.bin_width
+        deflection = self.deflection_front(t)
+        out = {"front": self.damage_front(t),
+               "deflection_front": deflection, "saw": self.saw_position(t)}
+        c, sawn = self.weak.collapse()
+        gone = (self.weak.bond() <= 0.0) & (sawn == 0)
+        out["collapse_height"] = float(np.mean(c[gone]) * p.weak_layer_thickness) if gone.any() else 0.0
+        y = self.slab.x.numpy()[self.base_index, 1].astype(np.float64)
+        w = self.base_y_ref.numpy() - y
+        out["touchdown"] = touchdown_distance(self.s_base, w, deflection, s_min=p.saw.cut_length) \
+            if deflection > p.saw.cut_length + 4.0 * bin_w else float("nan")
         u = self.slab.x.numpy()[self.marker_index].astype(np.float64) - self.slab.x0[self.marker_index]
         for k in range(len(self.markers)):
             out[f"marker{k}_ux"] = float(u[k, 0])
@@ -104,32 +106,54 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         return out
 
     def device_state(self) -> dict[str, np.ndarray]:
-        """Weak-layer reference and flags, front arrival times."""
+        """Weak-layer reference, saw flags and damage times; slab-base reference and deflection times."""
         return {**{f"weak_layer/{k}": v for k, v in self.weak.state().items()},
-                "arrival": self.arrival.numpy(), "arrival_failure": self.arrival_failure.numpy()}
+                "base_y_ref": self.base_y_ref.numpy(), "base_arrival": self.base_arrival.numpy()}
 
     def load_device_state(self, state: dict[str, np.ndarray]) -> None:
         """Restore :meth:`device_state`."""
         self.weak.load_state(entries_below(state, "weak_layer/"))
-        self.arrival.assign(state["arrival"])
-        self.arrival_failure.assign(state["arrival_failure"])
+        self.base_y_ref.assign(state["base_y_ref"])
+        self.base_arrival.assign(state["base_arrival"])
 
     def result(self) -> dict:
-        """Scene results from the series recorded so far (:func:`~mpm_warp.scenes.pst.analysis.pst_summary`)."""
+        """Scene results from the series and arrival times so far (:func:`.analysis.pst_summary`)."""
         times, series = self.series_arrays()
-        return pst_summary(self.params, times, series, arrival=self.arrival_times())
+        return pst_summary(self.params, times, series, self.bin_centres(), self.damage_arrival(),
+                           self.deflection_arrival())
 
     # ------------------------------------------------------------------ queries
-    def arrival_times(self) -> tuple[np.ndarray, np.ndarray]:
-        """Bin centres (m from the cut end) and first-collapse times (s, inf where not collapsed)."""
-        s = np.minimum((np.arange(self.n_bins) + 0.5) * self.bin, self.length)
-        return s, self.arrival.numpy().copy()
+    def bin_centres(self) -> np.ndarray:
+        """Centres of the front bins (m from the cut end)."""
+        p = self.params
+        return np.minimum((np.arange(p.n_bins) + 0.5) * p.bin_width, float(p.length))
+
+    def damage_arrival(self) -> np.ndarray:
+        """Damage time of every bin (s; inf: not yet): the median of its weak-layer particles' times."""
+        p = self.params
+        return self.weak.damage_arrival(self.s_weak, p.bin_width, p.n_bins)
+
+    def deflection_arrival(self) -> np.ndarray:
+        """Deflection time of every bin (s; inf: not yet): the median of its slab-base particles' times."""
+        p = self.params
+        return bin_median(self.s_base, self.base_arrival.numpy(), p.bin_width, p.n_bins)
+
+    def damage_front(self, t: float) -> float:
+        """The damage front at time ``t`` (m from the cut end)."""
+        p = self.params
+        return min(front_from_arrival(self.damage_arrival(), t, p.bin_width), float(p.length))
+
+    def deflection_front(self, t: float) -> float:
+        """The slab-deflection front at time ``t`` (m from the cut end)."""
+        p = self.params
+        return min(front_from_arrival(self.deflection_arrival(), t, p.bin_width), float(p.length))
 
     def saw_position(self, t: float) -> float:
         """Blade distance from the cut end (m) at time ``t`` (s)."""
-        return float(np.clip(self.speed * (t - self.t_start), 0.0, self.cut_length))
+        p = self.params
+        return float(np.clip(p.saw.speed * (t - p.saw_start), 0.0, p.saw.cut_length))
 
 
 def attach(sim) -> PSTMonitor:
-    """Add the PST's monitor (saw, failure rule, front trackers, frame series) to ``sim``; return it."""
+    """Add the PST's monitor (saw, weak-layer bookkeeping, front trackers, frame series) to ``sim``; return it."""
     return sim.add_monitor(PSTMonitor(sim))

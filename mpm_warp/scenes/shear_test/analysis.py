@@ -7,39 +7,66 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...materials import hardening_collapse
 from .params import ShearTestParams
 
 __all__ = ["ShearSummary", "shear_summary", "shear_curves", "analyze_shear_series"]
 
 
 def shear_curves(params: ShearTestParams, times, series: dict) -> dict[str, np.ndarray]:
-    """Curves of the pushing phase: ``u`` (m), ``gamma``, ``tau`` (Pa), ``q`` (Pa), ``axial`` (-), ``t`` (s).
+    """Curves of the pushing phase: ``u`` (m, the block's shear displacement), ``slip`` (m, the layer's own),
+    ``gamma`` (slip over ``D_wl``), ``tau`` (Pa), ``q`` (Pa), ``axial`` (-), ``bond`` (-), ``t`` (s).
 
-    Displacements are taken relative to the state when the push starts;
-    ``axial`` is the thickness loss over ``D_wl`` (positive = compaction).
+    Displacements are taken relative to the state when the push starts; ``axial`` is the thickness loss
+    over ``D_wl`` (positive = compaction).
     """
     t = np.asarray(times, dtype=float)
     i0 = min(int(np.searchsorted(t, params.push_start - 1e-12)), len(t) - 1)
     d_wl = float(params.weak_layer_thickness)
-    u = np.asarray(series["shear_displacement"], dtype=float)[i0:]
-    v = np.asarray(series["normal_displacement"], dtype=float)[i0:]
-    u = u - u[0]
-    return {"t": t[i0:], "u": u, "gamma": u / d_wl, "tau": np.asarray(series["shear_stress"], dtype=float)[i0:],
-            "q": np.asarray(series["mises_q"], dtype=float)[i0:], "axial": -(v - v[0]) / d_wl}
+
+    def part(name, default=0.0):
+        return np.asarray(series.get(name, np.full(len(t), default)), dtype=float)[i0:]
+
+    u, v, slip = part("shear_displacement"), part("normal_displacement"), part("layer_slip")
+    u, slip = u - u[0], slip - slip[0]
+    return {"t": t[i0:], "u": u, "slip": slip, "gamma": slip / d_wl, "tau": part("shear_stress"),
+            "q": part("mises_q"), "axial": -(v - v[0]) / d_wl, "bond": part("bond", 1.0)}
 
 
 def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
-    """Peak and residual strength, softening displacement and collapse (:func:`shear_summary`) with references."""
+    """Peak and residual strength, softening displacement and collapse of a shear test, with references.
+
+    On the layer's slip (:func:`shear_curves`): the peak and the residual of :func:`shear_summary`; the
+    softening displacement ``delta_s`` is the slip from the peak to the loss of the bond (the layer's
+    mean bond at zero: the end of the strength drop, before the collapse and the frictional residual);
+    the same on the block's displacement (``plate_``) for comparison with the loading-plate measurement
+    of a shear test. The collapse is given beside two laws: ``collapse_fraction_law`` (oedometric, the
+    debonded layer under the slab at rest) and ``collapse_fraction_critical_state`` (the debonded,
+    cohesionless layer at the critical state of its final mean Kirchhoff pressure ``p_final``: ``p0 =
+    2 p``; a sheared layer compacts more, MODEL.md 3b). The calibrated layer's predictions
+    (:meth:`ShearTestParams.references`) are copied in.
+    """
     c = shear_curves(params, times, series)
     if len(c["u"]) < 3:
         return {}
-    sm = shear_summary(c["u"], c["tau"], c["axial"])
+    sm = shear_summary(c["slip"], c["tau"], c["axial"])
+    lost = np.nonzero((np.arange(len(c["bond"])) > sm.peak_index) & (c["bond"] <= 0.0))[0]
+    k = int(lost[0]) if len(lost) else -1
+    ip = sm.peak_index
     refs = params.references()
+    mat = params.calibrated().material
+    p_end = float(np.asarray(series.get("p_kirchhoff", [math.nan]), dtype=float)[-1])
+    # the debonded layer (cohesion beta b = 0) at the critical state: p0 = 2 p, p the Kirchhoff pressure
+    cs = hardening_collapse(2.0 * p_end, mat.bulk, mat.xi, mat.p0_int_ini) \
+        if np.isfinite(p_end) and p_end > 0 else math.nan
     return {"peak_shear_stress": sm.peak_stress, "residual_shear_stress": sm.residual_stress,
-            "peak_displacement": sm.peak_displacement, "softening_displacement": sm.softening_displacement,
-            "drop_displacement": sm.drop_displacement,
-            "collapse_fraction": sm.collapse_fraction, "peak_q": float(np.max(c["q"])),
-            "sigma_n": float(refs["sigma_n"]), "collapse_fraction_law": float(refs["collapse_fraction_law"])}
+            "peak_slip": float(c["slip"][ip]),
+            "softening_displacement": float(c["slip"][k] - c["slip"][ip]) if k >= 0 else math.nan,
+            "plate_softening_displacement": float(c["u"][k] - c["u"][ip]) if k >= 0 else math.nan,
+            "bond_lost": k >= 0, "collapse_fraction": sm.collapse_fraction,
+            "collapse_fraction_critical_state": float(cs), "p_final": p_end, "peak_q": float(np.max(c["q"])),
+            **{f"{key}_calibrated" if key in ("delta_s", "w_f", "tau_p", "tau_peak") else key: float(v)
+               for key, v in refs.items()}}
 
 
 @dataclass(frozen=True)

@@ -4,13 +4,13 @@ import functools
 
 import warp as wp
 
-from ...kernels.types import mat33, vec3
+from ...kernels.types import mat, vec
 
 __all__ = ["push_kernel"]
 
 
 @functools.cache
-def push_kernel(T):
+def push_kernel(dim, T):
     """Displacement-controlled push of a particle group, every step before P2G.
 
     Sets ``v_x = 0`` before ``t_start`` and ``v_x = speed`` (m/s) after, zeroes the
@@ -20,11 +20,11 @@ def push_kernel(T):
     resistance over the step (the jump from rest to ``speed`` at the first step is
     the block's own inertia, not a reaction, and is left out).
     """
-    V = vec3(T)
-    M33 = mat33(T)
+    V = vec(dim, T)
+    M = mat(dim, T)
 
-    @wp.kernel(enable_backward=False)
-    def push(v: wp.array(dtype=V), C: wp.array(dtype=M33), clock: wp.array(dtype=wp.float64),
+    @wp.kernel(enable_backward=False, module="unique")
+    def push(v: wp.array(dtype=V), C: wp.array(dtype=M), clock: wp.array(dtype=wp.float64),
              t_start: wp.float64, speed: T, mass: T, impulse: wp.array(dtype=wp.float64)):
         i = wp.tid()
         vx = T(0.0)
@@ -33,8 +33,11 @@ def push_kernel(T):
             vx = speed
             if clock[0] - clock[1] >= t_start:  # not the first pushing step: no start-up jump counted
                 wp.atomic_add(impulse, 0, wp.float64(mass * (vx - vi[0])))
-        v[i] = V(vx, vi[1], vi[2])
+        vi[0] = vx
+        v[i] = vi
         c = C[i]
-        C[i] = M33(T(0.0), T(0.0), T(0.0), c[1, 0], c[1, 1], c[1, 2], c[2, 0], c[2, 1], c[2, 2])
+        for b in range(dim):
+            c[0, b] = T(0.0)
+        C[i] = c
 
     return push

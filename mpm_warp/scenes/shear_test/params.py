@@ -7,9 +7,8 @@ from dataclasses import asdict, dataclass, field
 from typing import ClassVar
 
 from ...checks import check_choices, finite_number, positive_int
-from ...materials import hardening_collapse
 from ..snow import GRAVITY, Settle, Slab, check_weak_layer_cells, slab_normal_stress
-from ..weak_layer import WeakLayer
+from ..weak_layer import CalibratedWeakLayer, WeakLayer
 
 __all__ = ["SlabLoad", "ShearTestParams"]
 
@@ -121,17 +120,23 @@ class ShearTestParams:
         return math.ceil(self.margin / self.dx) * self.dx
 
     @property
-    def width_z(self) -> float:
-        """Extent of the sample in z (m): one cell in plane strain, else ``width``."""
-        return float(self.dx if self.width <= 0.0 else self.width)
+    def depth(self) -> float:
+        """Extent of the sample in z (m): 1 m of depth in plane strain (quantities per metre), else ``width``."""
+        return float(1.0 if self.width <= 0.0 else self.width)
 
     @property
     def sample_area(self) -> float:
-        """Sheared area of the sample (m^2), ``L_s`` x its extent in z."""
-        return self.sample_length * self.width_z
+        """Sheared area of the sample (m^2), ``L_s`` x its depth."""
+        return self.sample_length * self.depth
+
+    def calibrated(self) -> CalibratedWeakLayer:
+        """The weak layer calibrated under the slab (:meth:`~mpm_warp.scenes.weak_layer.WeakLayer.calibrate`)."""
+        return self.weak_layer.calibrate(self.weak_layer_thickness, self.slab.density, self.slab.thickness,
+                                         abs(self.slope_angle), self.slab.E, self.slab.nu)
 
     def references(self) -> dict[str, float]:
-        """``sigma_n`` (Pa), ``p0_ini`` (Pa) and ``collapse_fraction_law`` (-, hardening law from 0 to ``sigma_n``)."""
-        wl = self.weak_layer.material(self.sigma_n)
-        return {"sigma_n": self.sigma_n, "p0_ini": wl.p0_ini,
-                "collapse_fraction_law": hardening_collapse(self.sigma_n, wl.bulk, wl.xi)}
+        """The calibrated layer's predictions: ``sigma_n``, ``tau_p``, ``tau_peak`` (material-point peak), ``p0_ini``
+        (Pa); ``delta_s`` (m), ``w_f`` (J/m^2); ``collapse_fraction_law`` (-, the debonded layer under the slab)."""
+        wl = self.calibrated()
+        return {"sigma_n": self.sigma_n, "tau_p": wl.tau_p, "tau_peak": wl.tau_peak, "p0_ini": wl.material.p0_ini,
+                "delta_s": wl.delta_s, "w_f": wl.w_f, "collapse_fraction_law": wl.h_c / self.weak_layer_thickness}

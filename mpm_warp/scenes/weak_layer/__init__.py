@@ -1,27 +1,22 @@
-"""The weak layer of the snow scenes: its parameters, its device action and its state during a run.
+"""The weak layer of the snow scenes: parameters in field quantities, their calibration, the run's bookkeeping.
 
-Everything about the weak layer's scene physics lives here (the engine's Cam-Clay aside):
+The layer is the engine's bonded Cam-Clay (:class:`~mpm_warp.materials.BondedCamClay`,
+``kernels/bonded_camclay.py``): strong while its bonds hold, softening over a plastic slip that
+costs a fracture energy, then collapsing under the slab (the anticrack). Modules:
 
-- :mod:`.params`: :class:`WeakLayer`, the Cam-Clay parameters and the failure rule's settings;
-- :mod:`.kernels`: :func:`weak_layer_kernel`, the collapse reference and the brittle rule: from the
-  end of settling on, a particle whose stress reaches the yield surface loses its cohesion at once
-  (``log_jp -> max(log_jp, failure_log_jp)``) and then compacts under the slab until the hardening
-  law carries the load (the anticrack's collapse). Why: the engine's associative return softens only
-  through plastic dilation, which the slab's weight stops at the critical state, and compaction on
-  the cap only hardens, so without it no crack runs by itself (checked: with ``failure = "none"`` the
-  front stops at the saw). Gaume et al. (2018) obtain the softening with a non-associative flow rule;
-  this rule is its brittle limit, implemented without touching the engine;
-- :mod:`.tracker`: :class:`WeakLayerTracker`, the device arrays (reference, failure flags) of one
-  run and their checkpoint state; :class:`ReferenceField`, the ``log_jp_ref`` output field of a
-  monitor (the collapse reference of :mod:`mpm_warp.post.fields`).
-
-Replacing the weak layer's physics means replacing these three modules; the PST and shear-test
-scenes use them through :class:`WeakLayer` and :class:`WeakLayerTracker` only.
+- :mod:`.params`: :class:`WeakLayer`, the field quantities (shear strength, fracture energy or
+  softening slip, collapse height) a scene takes;
+- :mod:`.calibration`: :func:`weak_layer_material`, the one place they become model parameters
+  (``p_bond``, ``kappa_s``, ``xi``), with the predictions the scenes compare with
+  (:class:`CalibratedWeakLayer`); :mod:`.paths`: the material-point reference paths it uses;
+- :mod:`.kernels` and :mod:`.tracker`: the saw's kerf, the collapse reference and the damage
+  arrival times of one run (:class:`WeakLayerTracker`), and the ``log_jp_ref`` output field.
 """
 
+from .calibration import CalibratedWeakLayer, weac_collapse_height, weak_layer_material
 from .kernels import weak_layer_kernel
-from .params import FAILURE_RULES, WeakLayer
-from .tracker import FAILED, INTACT, SAWN, ReferenceField, WeakLayerTracker
+from .params import WeakLayer
+from .tracker import DAMAGE_BOND, ReferenceField, WeakLayerTracker, bin_median
 
-__all__ = ["WeakLayer", "WeakLayerTracker", "ReferenceField", "weak_layer_kernel", "FAILURE_RULES", "INTACT",
-           "FAILED", "SAWN"]
+__all__ = ["WeakLayer", "CalibratedWeakLayer", "weak_layer_material", "weac_collapse_height", "WeakLayerTracker",
+           "ReferenceField", "weak_layer_kernel", "DAMAGE_BOND", "bin_median"]

@@ -1,4 +1,4 @@
-"""Closed-form references of the PST (MODEL.md 6-7), in SI units.
+"""Closed-form references of the snow experiments (MODEL.md 3b, 6-7), in SI units: one home for each formula.
 
 - Heierli (2005), elastic slab on a collapsing layer, ``D_f = E h^3 / 12``: crack speed
   ``c = (g D_f / (2 h_f rho h))^(1/4)``, touchdown distance ``l = 2.331 (2 h_f D_f / (g rho h))^(1/4)``.
@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import math
 
-from ..snow import GRAVITY
+from .snow import GRAVITY
 
-__all__ = ["heierli_speed", "heierli_touchdown", "critical_cut_length_formula"]
+__all__ = ["heierli_speed", "heierli_touchdown", "critical_cut_length_formula", "weac_collapse_height"]
 
 
 def heierli_speed(E: float, h: float, rho: float, h_f: float, g: float = GRAVITY) -> float:
@@ -37,3 +37,11 @@ def critical_cut_length_formula(tau_p: float, E: float, nu: float, D_wl: float, 
                                 g: float = GRAVITY) -> float:
     """Flat-ground critical cut length ``sqrt(2 tau_p E' D_wl / (G_wl rho g))`` (m), ``E' = E/(1-nu^2)``."""
     return math.sqrt(2.0 * tau_p * E / (1.0 - nu**2) * D_wl / (G_wl * rho * g))
+
+
+def weac_collapse_height(D_wl: float) -> float:
+    """WEAC fit of the weak-layer collapse height ``h_c = 4.70 (1 - exp(-D_wl / 7.78 mm)) mm`` (m; ``D_wl`` in m).
+
+    Rosendahl and Weissgraeber (2020), fitted to the PST collapse heights of van Herwijnen et al. (2016).
+    """
+    return 4.70e-3 * (1.0 - math.exp(-D_wl / 7.78e-3))

@@ -1,0 +1,232 @@
+"""Error against run time for the snow scenes: how fine must a PST and a shear test be (issue 14).
+
+Two ladders of grid spacings (halving; 2 particles per cell and axis and CFL factor 0.4 fixed), on
+this machine's CPU in 2D (plane strain), float32:
+
+- ``pst``: a flat PST of the production snow (``pst_flat``'s slab, layer and saw) on a 2.2 m column
+  with a 0.3 m slab and a 6 cm weak layer, so that the coarsest level still has the minimum 3 cells
+  across the layer: dx = 20, 10, 5, 2.5 mm = 3, 6, 12, 24 cells. Quantities: the critical cut
+  (bisection on the saw's stop position, trial runs forked from one base run:
+  :func:`mpm_warp.scenes.pst.critical_cut`, bracket [0.1, 0.7] m to 2 cm, the finest level bracketed
+  within 25 % of the one before), the mean damage-front speed from the base run's 0.7 m cut to the
+  far end zone (1.2 m), the touchdown distance and the collapse height of the base run;
+- ``shear``: the shear test of SI Note 2 (``shear_test``) at 4, 8, 16, 32 cells across its 3 cm
+  layer. Quantities: peak, softening slip ``delta_s``, collapse at the end of the 8 mm push.
+
+Per quantity: the error of each level against the finest, against a Richardson extrapolation of the
+three finest where the observed order allows it (0.5 <= p <= 4, monotone), each level's wall time
+(the stepping, kernels compiled), steps, particles and particle-steps per second; the wall time to
+5 % and to 1 % error (log-log interpolation along the ladder, or "not reached"). One level is also run
+in float64 (``--precision-level``) to say whether float32 limits a quantity.
+
+Writes ``benchmarks/results/error_vs_runtime_snow.json`` after every level (a killed run keeps the
+finished levels; a rerun skips them unless ``--redo``) and ``error_vs_runtime_snow.png`` (error
+against wall time, log-log, one line per quantity).
+
+Usage (hours on 2 CPU cores; the finest PST level dominates)::
+
+    nohup .venv/bin/python benchmarks/error_vs_runtime_snow.py > ladder.log 2>&1 &
+    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder shear --levels 0 1   # the two coarsest
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from common import RESULTS, environment, write_json  # noqa: E402
+
+import mpm_warp as mw  # noqa: E402
+from mpm_warp.memory import estimate_memory  # noqa: E402
+from mpm_warp.scenes.pst import critical_cut  # noqa: E402
+
+OUT = "error_vs_runtime_snow"
+TARGETS = (0.05, 0.01)
+#: the ladder PST: production snow, 2.2 m column, 0.3 m slab, 6 cm layer (3 cells at the coarsest level)
+PST_SCENE = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
+             "scene.substratum_thickness=0.06", "scene.margin=0.05"]
+PST_DX = [0.02, 0.01, 0.005, 0.0025]
+PST_BRACKET = dict(lo=0.1, hi=0.7, tol=0.02)
+SHEAR_CELLS = [4, 8, 16, 32]
+QUANTITIES = {"pst": ("critical_cut", "speed", "touchdown", "collapse_height"),
+              "shear": ("peak", "delta_s", "collapse")}
+UNITS = {"critical_cut": "m", "speed": "m/s", "touchdown": "m", "collapse_height": "m", "peak": "Pa",
+         "delta_s": "m", "collapse": "1"}
+
+
+def pst_level(dx: float, precision: str, bracket: dict, device: str) -> dict:
+    """One PST level: critical cut by bisection, and the base run's speed, touchdown and collapse height."""
+    sc = mw.load_scenario("pst_flat", PST_SCENE + [f"scene.dx={dx!r}", f'precision="{precision}"'])
+    t0 = time.perf_counter()
+    res = critical_cut(sc, device=device, base_run_distance=sc.scene.length, base_free_run=0.5, **bracket,
+                       log=lambda s: print(f"  pst dx {dx}: {s}", flush=True))
+    wall = time.perf_counter() - t0
+    b = res.base
+    n_particles = estimate_memory(sc, device).n_particles
+    return {"dx": dx, "cells_across_layer": sc.scene.weak_layer_thickness / dx, "precision": precision,
+            "critical_cut": res.value if res.bracketed else math.nan, "critical_cut_bracket": [res.lo, res.hi],
+            "bracketed": res.bracketed, "note": res.note, "trials": res.trials,
+            "speed": b.get("damage_speed_mean"), "speed_over": b.get("damage_speed_mean_over"),
+            "touchdown": b.get("touchdown"), "collapse_height": b.get("collapse_height"),
+            "wall_time_s": wall, "n_particles": n_particles,
+            "simulated_s": float(sum(t["t_end"] for t in res.trials)),
+            "bisection": bracket}
+
+
+def shear_level(cells: int, precision: str, device: str) -> dict:
+    """One shear-test level: peak, softening slip, collapse."""
+    sc = mw.load_scenario("shear_test")
+    dx = sc.scene.weak_layer_thickness / cells
+    rr = mw.run("shear_test", device=device, overrides=[f"scene.dx={dx!r}", f'precision="{precision}"'])
+    r = rr.scene_result
+    return {"dx": dx, "cells_across_layer": cells, "precision": precision, "peak": r["peak_shear_stress"],
+            "delta_s": r["softening_displacement"], "collapse": r["collapse_fraction"],
+            "wall_time_s": rr.wall_time, "steps": rr.steps, "n_particles": rr.n_particles,
+            "particle_steps_per_s": rr.particle_steps_per_s}
+
+
+def richardson(h, v):
+    """Richardson extrapolation of the three finest ``(h, v)`` (halving): ``(value, order)`` or ``(nan, p)``."""
+    if len(v) < 3 or not all(np.isfinite(v[-3:])):
+        return math.nan, math.nan
+    a, b, c = v[-3:]
+    if (b - a) == 0 or (c - b) == 0 or (c - b) / (b - a) <= 0:
+        return math.nan, math.nan
+    p = math.log(abs((b - a) / (c - b))) / math.log(2.0)
+    if not 0.5 <= p <= 4.0:
+        return math.nan, p
+    return c + (c - b) / (2.0**p - 1.0), p
+
+
+def time_to(errors, walls, target: float) -> dict:
+    """Wall time (s) to ``target`` error along the ladder (coarse to fine), log-log interpolated."""
+    pts = [(e, w) for e, w in zip(errors, walls, strict=True) if np.isfinite(e)]
+    if not pts:
+        return {"status": "no data"}
+    if pts[0][0] <= target:
+        return {"status": "already at the coarsest", "wall_time_s": pts[0][1]}
+    for (e1, w1), (e2, w2) in zip(pts, pts[1:], strict=False):
+        if e1 > target >= e2 and e2 > 0:
+            s = (math.log(target) - math.log(e1)) / (math.log(e2) - math.log(e1))
+            return {"status": "interpolated", "wall_time_s": math.exp(math.log(w1) + s * (math.log(w2) - math.log(w1)))}
+        if e1 > target and e2 == 0.0:
+            return {"status": "at the finest (the reference)", "wall_time_s": w2}
+    return {"status": "not reached", "error_at_finest_compared": pts[-1][0]}
+
+
+def summarise(ladder: str, levels: list[dict]) -> dict:
+    """Errors against the finest level and the Richardson value, orders, times to 5 % and 1 %, per quantity."""
+    out = {}
+    levels = [lv for lv in levels if lv["precision"] == "float32"]
+    if len(levels) < 2:
+        return out
+    walls = [lv["wall_time_s"] for lv in levels]
+    h = [lv["dx"] for lv in levels]
+    for q in QUANTITIES[ladder]:
+        v = np.array([lv[q] if lv[q] is not None else math.nan for lv in levels], float)
+        ref = v[-1]
+        err = np.abs(v / ref - 1.0) if np.isfinite(ref) and ref != 0 else np.full(len(v), math.nan)
+        rich, p = richardson(h, v)
+        err_r = np.abs(v / rich - 1.0) if np.isfinite(rich) else np.full(len(v), math.nan)
+        out[q] = {"values": v.tolist(), "error_vs_finest": err.tolist(), "richardson": rich, "observed_order": p,
+                  "error_vs_richardson": err_r.tolist(),
+                  "time_to": {f"{int(100 * t)}%": time_to(list(err_r if np.isfinite(rich) else err), walls, t)
+                              for t in TARGETS},
+                  "reference_used_for_time_to": "richardson" if np.isfinite(rich) else "finest level"}
+    return out
+
+
+def figure(data: dict, path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    for ax, ladder in zip(axes, ("pst", "shear"), strict=True):
+        lv = [x for x in data["ladders"].get(ladder, []) if x["precision"] == "float32"]
+        summ = data["summary"].get(ladder, {})
+        drawn = False
+        for k, q in enumerate(QUANTITIES[ladder]):
+            if q not in summ:
+                continue
+            use_r = summ[q]["reference_used_for_time_to"] == "richardson"
+            e = summ[q]["error_vs_richardson"] if use_r else summ[q]["error_vs_finest"]
+            pts = [(w["wall_time_s"], ee) for w, ee in zip(lv, e, strict=False) if np.isfinite(ee) and ee > 0]
+            if pts:
+                drawn = True
+                ax.loglog(*zip(*pts, strict=True), "o-", color=f"C{k}",
+                          label=f"{q} (vs {'Richardson' if use_r else 'finest'})")
+        for t in TARGETS:
+            ax.axhline(t, color="0.6", ls=":", lw=1)
+        ax.set(xlabel="wall time of the level [s] (CPU, 2D, float32)", ylabel="relative error",
+               title=f"{ladder}: dx halving, " + ", ".join(f"{x['cells_across_layer']:.0f}" for x in lv)
+                     + " cells across the layer")
+        if drawn:
+            ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def load(results: str = RESULTS) -> dict:
+    path = os.path.join(results, OUT + ".json")
+    if os.path.isfile(path):
+        with open(path) as fh:
+            return json.load(fh)
+    return {"ladders": {"pst": [], "shear": []}, "summary": {}}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--ladder", choices=["pst", "shear", "both"], default="both")
+    ap.add_argument("--levels", type=int, nargs="*", default=None, help="level indices (default all)")
+    ap.add_argument("--precision-level", type=int, default=1, help="level also run in float64 (-1: none)")
+    ap.add_argument("--redo", action="store_true", help="run levels the JSON already has")
+    ap.add_argument("--device", default="cpu")
+    ap.add_argument("--results", default=RESULTS, help="folder of the JSON and the figure")
+    a = ap.parse_args(argv)
+    data = load(a.results)
+    data["environment"] = environment(a.device)
+    ladders = ["shear", "pst"] if a.ladder == "both" else [a.ladder]
+    for ladder in ladders:
+        n = len(PST_DX if ladder == "pst" else SHEAR_CELLS)
+        idx = list(range(n)) if a.levels is None else a.levels
+        jobs = [(i, "float32") for i in idx]
+        if a.precision_level >= 0 and (a.levels is None or a.precision_level in idx):
+            jobs.append((a.precision_level, "float64"))
+        have = data["ladders"].setdefault(ladder, [])
+        for i, prec in jobs:
+            done = [x for x in have if x.get("level") == i and x["precision"] == prec]
+            if done and not a.redo:
+                continue
+            print(f"{ladder} level {i} ({prec})", flush=True)
+            if ladder == "pst":
+                prev = [x for x in have if x.get("level") == i - 1 and x["precision"] == "float32"]
+                bracket = dict(PST_BRACKET)
+                if i == n - 1 and prev and math.isfinite(prev[0]["critical_cut"]):
+                    c = prev[0]["critical_cut"]
+                    bracket = dict(lo=0.75 * c, hi=1.25 * c, tol=PST_BRACKET["tol"])
+                rec = pst_level(PST_DX[i], prec, bracket, a.device)
+            else:
+                rec = shear_level(SHEAR_CELLS[i], prec, a.device)
+            rec["level"] = i
+            have[:] = [x for x in have if not (x.get("level") == i and x["precision"] == prec)] + [rec]
+            have.sort(key=lambda x: (x["precision"], x["level"]))
+            data["summary"] = {k: summarise(k, v) for k, v in data["ladders"].items()}
+            write_json(OUT, data, a.results)
+            figure(data, os.path.join(a.results, OUT + ".png"))
+            print(json.dumps({k: rec[k] for k in rec if k in (*QUANTITIES[ladder], "wall_time_s")}), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

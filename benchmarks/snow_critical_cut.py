@@ -1,0 +1,127 @@
+"""Critical cut length of the PST by bisection on the saw's stop position (issue 10).
+
+Each case bisects :func:`mpm_warp.scenes.pst.critical_cut` on a PST column (trial runs forked from
+one base run, :mod:`mpm_warp.scenes.pst.critical`) and writes ``benchmarks/results/snow_critical_cut.json``
+(one entry per case, merged into what is there) and ``snow_critical_cut.png`` (the trials: cut
+against outcome, with the bracket, beside Gaume et al. 2017's formula):
+
+- ``flat``: ``pst_flat`` on a 3 m column;
+- ``slope``: ``pst_slope`` (30 deg) on a 3 m column;
+- ``flat_saw_half``: the saw at half speed (0.5 m/s);
+- ``flat_dx_half``: the grid spacing halved (8 cells across the layer) on a 2.2 m column, checked
+  at 0.8 and 1.2 times the ``flat`` critical cut only (two trials: the issue's 20 % band), each
+  8x the cost of a ``flat`` trial.
+
+Usage::
+
+    nohup .venv/bin/python benchmarks/snow_critical_cut.py flat slope flat_saw_half flat_dx_half > cut.log 2>&1 &
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from common import RESULTS, environment, write_json  # noqa: E402
+
+import mpm_warp as mw  # noqa: E402
+from mpm_warp.scenes.pst import critical_cut  # noqa: E402
+
+FIELD_CUT = (0.15, 0.6)   # m: the issue's band for a flat PST (field: a few tens of centimetres)
+#: the column of the bisections: 3 m leaves 1 m of run beyond a 0.8 m cut and the slab's end zone
+COLUMN = ["scene.length=3.0", "scene.marker_spacing=0.1"]
+CASES = {
+    "flat": ("pst_flat", COLUMN, dict(lo=0.1, hi=0.8, tol=0.02)),
+    "slope": ("pst_slope", COLUMN, dict(lo=0.05, hi=0.8, tol=0.02)),
+    "flat_saw_half": ("pst_flat", COLUMN + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.8, tol=0.02)),
+    "flat_dx_half": ("pst_flat", ["scene.length=2.2", "scene.dx=0.00375"], None),   # bracket from "flat"
+}
+OUT = "snow_critical_cut"
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def load() -> dict:
+    path = os.path.join(RESULTS, OUT + ".json")
+    if os.path.isfile(path):
+        with open(path) as fh:
+            data = json.load(fh)
+        if isinstance(data.get("cases"), dict):
+            return data
+    return {"cases": {}}
+
+
+def figure(data: dict, path: str) -> None:
+    plt = _plt()
+    cases = data["cases"]
+    fig, ax = plt.subplots(figsize=(8, 0.9 + 0.7 * len(cases)))
+    for i, c in enumerate(cases.values()):
+        for tr in c["trials"]:
+            ax.plot(tr["cut"], i, "o" if tr["propagated"] else "x", color="C3" if tr["propagated"] else "C0", ms=7)
+        ax.plot([c["lo"], c["hi"]], [i, i], "-", color="k", lw=3, alpha=0.4)
+        if c.get("gaume") is not None:
+            ax.plot(c["gaume"], i, "D", color="C2", ms=7, mfc="none")
+    ax.axvspan(*FIELD_CUT, color="0.9", zorder=0)
+    ax.set_yticks(range(len(cases)), list(cases))
+    ax.set(xlabel="saw cut length [m]", title="critical cut: x arrested, o propagated, bar = bracket, "
+                                             "diamond = Gaume et al. 2017, grey = 0.15-0.6 m")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def run_case(name: str, data: dict, device: str) -> dict:
+    scene, overrides, bracket = CASES[name]
+    sc = mw.load_scenario(scene, overrides)
+    if bracket is None:        # the 20 % band around the flat case
+        a = data["cases"]["flat"]["value"]
+        if not math.isfinite(a):
+            raise SystemExit("flat_dx_half needs the flat case's critical cut first")
+        bracket = dict(lo=0.8 * a, hi=1.2 * a, tol=0.4 * a)
+    t0 = time.perf_counter()
+    res = critical_cut(sc, device=device, log=lambda s: print(f"{name}: {s}", flush=True), **bracket)
+    wall = time.perf_counter() - t0
+    refs = sc.scene.references()
+    out = {"scene": scene, "overrides": overrides, "bracket": bracket, "value": res.value, "bracketed": res.bracketed,
+           "note": res.note, "lo": res.lo,
+           "hi": res.hi, "trials": res.trials, "runaway_cut_of_base": res.runaway_cut, "wall_s": wall,
+           "dx": sc.scene.dx, "saw_speed": sc.scene.saw.speed, "slope_angle": sc.scene.slope_angle,
+           "gaume": refs.get("critical_cut_gaume"),
+           "base_speed_mean": res.base.get("damage_speed_mean"), "base_propagated": res.base.get("propagated"),
+           "environment": environment(device)}
+    print(f"{name}: critical cut in [{res.lo:.3f}, {res.hi:.3f}] m ({wall:.0f} s) {res.note}", flush=True)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("cases", nargs="+", choices=list(CASES))
+    ap.add_argument("--device", default="cpu")
+    a = ap.parse_args(argv)
+    data = load()
+    for name in a.cases:
+        data["cases"][name] = run_case(name, data, a.device)
+        flat = data["cases"].get("flat")
+        for other in ("flat_saw_half", "flat_dx_half"):
+            if flat and other in data["cases"] and math.isfinite(flat["value"]):
+                data["cases"][other]["change_from_flat"] = data["cases"][other]["value"] / flat["value"] - 1.0
+        write_json(OUT, data)
+        figure(data, os.path.join(RESULTS, OUT + ".png"))
+    return 0 if all(math.isfinite(c["value"]) for c in data["cases"].values()) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,117 @@
+"""Crack speed and critical cut against the weak layer's fracture energy w_f: a Dask sweep (issue 10).
+
+For each ``w_f`` (default 0.1, 0.3, 1.0 J/m^2; the rest of the layer as ``pst_flat``) one Dask task
+bisects the critical cut (:func:`mpm_warp.scenes.pst.critical_cut`, trial runs forked from one base
+run) on a 4 m column; its base run (the saw to ``hi``) runs on into the far end zone, and its mean
+front speed is the crack speed. Tasks run on a local Dask cluster (one worker process per core, one
+thread each) or on ``--scheduler``. Writes ``benchmarks/results/snow_wf_sweep.json`` and ``.png``
+(speed and critical cut against ``w_f``, beside the field band, Heierli's speed and Gaume et al.
+2017's critical cut, which does not depend on ``w_f``).
+
+Usage::
+
+    nohup .venv/bin/python benchmarks/snow_wf_sweep.py > wf.log 2>&1 &
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from common import RESULTS, environment, write_json  # noqa: E402
+
+COLUMN = ["scene.length=4.0"]
+FIELD_SPEED = (20.0, 30.0)
+FIELD_CUT = (0.15, 0.6)
+
+
+def one_case(w_f: float, lo: float, hi: float, tol: float, device: str) -> dict:
+    """Critical cut and crack speed of pst_flat with fracture energy ``w_f`` (J/m^2): runs in a Dask worker."""
+    import mpm_warp as mw
+    from mpm_warp.scenes.pst import critical_cut
+
+    sc = mw.load_scenario("pst_flat", COLUMN + [f"scene.weak_layer.w_f={w_f!r}", "scene.weak_layer.delta_s=0.0"])
+    t0 = time.perf_counter()
+    lines = []
+    res = critical_cut(sc, lo, hi, tol=tol, base_run_distance=sc.scene.length, device=device, n_threads=1,
+                       log=lines.append)
+    b = res.base
+    cal = sc.scene.calibrated()
+    return {"w_f": w_f, "delta_s": cal.delta_s, "kappa_s": cal.kappa_s, "debond_energy": cal.debond_energy,
+            "critical_cut": res.value, "bracketed": res.bracketed, "note": res.note, "lo": res.lo, "hi": res.hi,
+            "trials": res.trials, "runaway_cut_of_base": res.runaway_cut,
+            "speed": b.get("damage_speed_mean"), "speed_over": b.get("damage_speed_mean_over"),
+            "deflection_speed": b.get("deflection_speed_mean"), "speed_max": b.get("damage_speed_max"),
+            "speed_profile": b.get("damage_speed_profile"), "ran_to_end": b.get("ran_to_end"),
+            "collapse_height": b.get("collapse_height"), "heierli_speed_run": b.get("heierli_speed_run"),
+            "heierli_speed": b.get("heierli_speed"), "critical_cut_gaume": b.get("critical_cut_gaume"),
+            "wall_s": time.perf_counter() - t0, "log": lines}
+
+
+def figure(rows: list, path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    w = [r["w_f"] for r in rows]
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    ax[0].plot(w, [r["speed"] for r in rows], "o-", color="C3", label="damage front, mean from the cut")
+    ax[0].plot(w, [r["heierli_speed_run"] for r in rows], "s--", color="C2", label="Heierli (run's collapse)")
+    ax[0].axhspan(*FIELD_SPEED, color="0.88", label="field 20-30 m/s")
+    ax[0].set(xscale="log", xlabel="fracture energy w_f [J/m^2]", ylabel="crack speed [m/s]", title="speed")
+    ax[0].legend(fontsize=8)
+    for r in rows:
+        ax[1].plot([r["w_f"]] * 2, [r["lo"], r["hi"]], "-", color="C0", lw=4, alpha=0.5)
+    ax[1].plot(w, [r["critical_cut"] for r in rows], "o-", color="C0", label="bisection (bar: bracket)")
+    ax[1].plot(w, [r["critical_cut_gaume"] for r in rows], "D:", color="C2", mfc="none",
+               label="Gaume et al. 2017 (no w_f)")
+    ax[1].axhspan(*FIELD_CUT, color="0.88", label="0.15-0.6 m")
+    ax[1].set(xscale="log", xlabel="fracture energy w_f [J/m^2]", ylabel="critical cut [m]", title="critical cut")
+    ax[1].legend(fontsize=8)
+    fig.suptitle("pst_flat (4 m column): the weak layer's fracture energy swept, everything else fixed", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--w-f", default="0.1,0.3,1.0", help="fracture energies (J/m^2), comma separated")
+    ap.add_argument("--lo", type=float, default=0.05)
+    ap.add_argument("--hi", type=float, default=1.0)
+    ap.add_argument("--tol", type=float, default=0.02)
+    ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--device", default="cpu")
+    a = ap.parse_args(argv)
+    from dask.distributed import Client, LocalCluster
+
+    values = [float(v) for v in a.w_f.split(",")]
+    t0 = time.perf_counter()
+    os.environ["MPM_WARP_THREADS"] = "1"
+    cluster = None if a.scheduler else LocalCluster(n_workers=min(a.workers, len(values)), threads_per_worker=1,
+                                                     dashboard_address=None)
+    with Client(a.scheduler or cluster) as client:
+        futures = [client.submit(one_case, w, a.lo, a.hi, a.tol, a.device, pure=False) for w in values]
+        rows = client.gather(futures)
+    if cluster is not None:
+        cluster.close()
+    rows.sort(key=lambda r: r["w_f"])
+    data = {"cases": rows, "column": COLUMN, "bracket": [a.lo, a.hi, a.tol], "wall_s": time.perf_counter() - t0,
+            "environment": environment(a.device)}
+    write_json("snow_wf_sweep", data)
+    figure(rows, os.path.join(RESULTS, "snow_wf_sweep.png"))
+    for r in rows:
+        print(f"w_f {r['w_f']:.3g} J/m^2: critical cut {r['critical_cut']:.3g} m [{r['lo']:.3g}, {r['hi']:.3g}] "
+              f"{r['note']}; speed {r['speed']:.3g} m/s (Heierli {r['heierli_speed_run']:.3g}); {r['wall_s']:.0f} s")
+    return 0 if all(math.isfinite(r["critical_cut"]) for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,187 @@
+"""Critical cut length of a PST by bisection on the saw's stop position, trial runs forked from one base run.
+
+Two runs that differ only in where the saw stops are the same run until the shorter cut ends (the
+blade moves at a fixed speed). So one *base run* with the longest cut is stepped once, with a
+snapshot (:func:`mpm_warp.snapshot.take_snapshot`) every ``snapshot_every`` metres of sawing; a
+trial cut ``a`` starts from the last snapshot before the blade reached ``a``, in a simulation whose
+saw stops at ``a``, and runs until its crack has run ``run_distance`` beyond the cut (it
+propagated) or ``free_run`` seconds after the saw stopped (it arrested). Each trial pays for its free
+run only, never for the settling. The predicate is monotone in the cut, and
+:func:`~mpm_warp.scenes.fronts.bisect_threshold` brackets the critical cut to ``tol``.
+
+The result states the bracket, every trial (cut, outcome, how far its damage front got, its
+runaway time) and the base run's one-run estimate (``runaway_cut``, see :mod:`.analysis`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time as _time
+
+from ...simulation import Simulation
+from ..fronts import bisect_threshold
+from .analysis import end_zone
+from .monitor import PSTMonitor, attach
+from .params import PSTParams
+
+__all__ = ["CriticalCut", "critical_cut"]
+
+
+@dataclasses.dataclass
+class CriticalCut:
+    """Critical cut of a PST (m) from bisection over forked trial runs.
+
+    Attributes
+    ----------
+    value : float
+        Midpoint of the final bracket (m).
+    lo, hi : float
+        The longest cut that arrested and the shortest that propagated (m).
+    trials : list of dict
+        ``cut`` (m), ``propagated``, ``front`` (m: the damage front's reach when the trial ended),
+        ``t_end`` (s: simulated time the trial ended), ``wall`` (s).
+    runaway_cut : float
+        The base run's one-run estimate (m; nan if its crack never ran away from the saw).
+    base : dict
+        The base run's :func:`~.analysis.pst_summary` (cut ``hi`` of the first call).
+    wall : float
+        Wall time of the whole search (s).
+    bracketed : bool
+        False when a cut of ``lo`` propagated or one of ``hi`` arrested: ``value`` is nan and ``note``
+        says which (the trials are kept).
+    note : str
+    """
+
+    value: float
+    lo: float
+    hi: float
+    trials: list
+    runaway_cut: float
+    base: dict
+    wall: float
+    bracketed: bool = True
+    note: str = ""
+
+    def to_dict(self) -> dict:
+        """Plain dict (JSON)."""
+        return dataclasses.asdict(self)
+
+
+def _with_cut(scenario, cut: float):
+    scene = dataclasses.replace(scenario.scene, saw=dataclasses.replace(scenario.scene.saw, cut_length=float(cut)))
+    return dataclasses.replace(scenario, scene=scene)
+
+
+def _simulation(scenario, device, n_threads) -> tuple[Simulation, PSTMonitor]:
+    sim = Simulation(scenario, device=device, n_threads=n_threads)
+    return sim, attach(sim)
+
+
+def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance: float = 1.0,
+                 free_run: float = 0.2, snapshot_every: float | None = None, check_interval: float = 0.01,
+                 base_run_distance: float | None = None, base_free_run: float | None = None,
+                 device: str | None = None, n_threads: int | None = None, log=None) -> CriticalCut:
+    """Bisect the critical cut of the PST ``scenario`` within ``[lo, hi]`` (m) to ``tol`` (m).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A PST scenario (``scenario.scene`` a :class:`PSTParams`); its own cut length is ignored.
+    lo, hi : float
+        Bracket (m): a cut of ``lo`` should arrest and one of ``hi`` propagate (both are run; when
+        not, the result is not ``bracketed`` and its ``note`` names the end).
+    tol : float
+        Bracket width to stop at (m).
+    run_distance : float
+        A trial propagated once its damage front ran this far beyond its cut (m), or into the end zone
+        (within one slab thickness of the far end, as :func:`~.analysis.pst_summary`).
+    free_run : float
+        A trial arrested if it has not propagated this long after its saw stopped (s).
+    snapshot_every : float, optional
+        Blade travel between snapshots of the base run (m); default ``tol / 2``.
+    base_run_distance : float, optional
+        How far beyond ``hi`` the base run's crack must run before it stops (m); default
+        ``run_distance``; ``length`` runs it into the end zone, so that its ``base`` summary holds the
+        crack's speed over the column.
+    base_free_run : float, optional
+        The base run's ``free_run`` (s); default ``free_run``.
+    check_interval : float
+        Simulated time between the trial's front checks (s); each is a frame of the monitor's series, so
+        the ``base`` summary has a touchdown and a collapse height.
+    device, n_threads
+        As :class:`~mpm_warp.Simulation`.
+    log : callable, optional
+        ``log(str)`` for a line per trial.
+    """
+    p = scenario.scene
+    if not isinstance(p, PSTParams):
+        raise TypeError("critical_cut needs a PST scenario (scene kind 'pst')")
+    if not 0.0 <= lo < hi <= p.length:
+        raise ValueError(f"need 0 <= lo < hi <= length (got lo={lo}, hi={hi}, length={p.length})")
+    wall0 = _time.perf_counter()
+    step = float(snapshot_every or 0.5 * tol)
+    v, t_saw = float(p.saw.speed), p.saw_start
+    # ---------------------------------------------------------------- base run: cut hi, snapshots while sawing
+    base_sc = _with_cut(scenario, hi)
+    sim, mon = _simulation(base_sc, device, n_threads)
+    snaps = []                               # (blade position, snapshot), increasing
+    sim.step_to(t_saw)
+    a = min(lo, hi)                          # no trial starts before lo
+    sim.step_to(t_saw + a / v)
+    while True:
+        snaps.append((a, sim.snapshot()))
+        if a >= hi:
+            break
+        a = min(a + step, hi)
+        sim.step_to(t_saw + a / v)
+    base = _trial(sim, mon, hi, run_distance if base_run_distance is None else base_run_distance,
+                  free_run if base_free_run is None else base_free_run, check_interval)
+    base_summary = mon.result()
+    trials = [{**base, "wall": _time.perf_counter() - wall0}]
+    if log:
+        log(f"cut {hi:.4g} m (base): propagated={base['propagated']}, front {base['front']:.3f} m")
+    cache = {hi: base["propagated"]}
+
+    def propagates(cut: float) -> bool:
+        if cut in cache:
+            return cache[cut]
+        t0 = _time.perf_counter()
+        k = max(i for i, (pos, _) in enumerate(snaps) if pos <= cut + 1e-12)
+        tsim, tmon = _simulation(_with_cut(scenario, cut), device, n_threads)
+        tsim.load_snapshot(*snaps[k][1])
+        out = _trial(tsim, tmon, cut, run_distance, free_run, check_interval)
+        out["wall"] = _time.perf_counter() - t0
+        trials.append(out)
+        cache[cut] = out["propagated"]
+        if log:
+            log(f"cut {cut:.4g} m: propagated={out['propagated']}, front {out['front']:.3f} m "
+                f"({out['wall']:.0f} s)")
+        return out["propagated"]
+
+    runaway = float(base_summary.get("runaway_cut", math.nan))
+    low = propagates(lo)
+    if low or not cache[hi]:   # the critical cut is not in the bracket: say which end, keep the trials
+        why = f"a cut of {lo:g} m propagated" if low else f"a cut of {hi:g} m arrested"
+        return CriticalCut(math.nan, lo, hi, trials, runaway, base_summary, _time.perf_counter() - wall0,
+                           bracketed=False, note=why)
+    b = bisect_threshold(propagates, lo, hi, tol, check_ends=False)
+    return CriticalCut(b.value, b.lo, b.hi, trials, runaway, base_summary, _time.perf_counter() - wall0)
+
+
+def _trial(sim: Simulation, mon: PSTMonitor, cut: float, run_distance: float, free_run: float,
+           check_interval: float) -> dict:
+    """Run a trial from where ``sim`` is until its crack propagated or arrested."""
+    p = mon.params
+    goal = min(cut + run_distance, p.length - end_zone(p))
+    t_stop = p.saw_start + cut / p.saw.speed + free_run
+    t = sim.time
+    front = 0.0
+    while t < t_stop - 1e-12:
+        t = min(t + check_interval, t_stop)
+        sim.step_to(t)
+        mon.frame_scalars(sim)          # a frame of the monitor's series (touchdown, collapse height)
+        front = mon.damage_front(t)
+        if front >= goal:
+            break
+    return {"cut": float(cut), "propagated": bool(front >= goal), "front": float(front), "t_end": float(sim.time)}
