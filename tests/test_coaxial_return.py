@@ -28,13 +28,13 @@ from mpm_warp.kernels.types import mat
 from mpm_warp.model import material_params
 
 SNOW = mw.CamClaySnow(1.0e6, 0.3, 200.0, M=1.2, beta=0.3, xi=0.5, p0_ini=800.0)
-LAYER = mw.BondedCamClay(1.0e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.01, p_bond=1500.0, kappa_s=0.02)
+LAYER = mw.BondedCamClay(1.0e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.01, p_bond=1500.0, kappa_s=20.0)  # J/m^3
 TYPES = {"float32": (wp.float32, np.float32), "float64": (wp.float64, np.float64)}
 #: rounding unit per precision
 U = {"float32": 2.0**-24, "float64": 2.0**-53}
 #: tolerances in rounding units of each quantity's scale (``_errors``), beyond the principal-strain path's own error
-#: (float64 worst measured: H 2.8, tau 31, log_jp 51, kappa 24; heavy projections onto small ellipses amplify the
-#: rounding of the trial)
+#: (float64 worst measured: H 2.8, tau 31, log_jp 51, kappa 5.6; heavy projections onto small ellipses amplify
+#: the rounding of the trial)
 TOL_U = {"H": 16, "hzz": 16, "tau": 128, "log_jp": 128, "kappa": 128}
 
 
@@ -109,15 +109,15 @@ def _series_applies(H):
 def _errors(got, ref, inputs, material, which):
     """Largest errors of an update against the reference, in rounding units of the quantity's natural scale:
     ``H`` of ``|F_tr|``, ``h_zz`` of ``1 + h_zz``, ``tau`` of the trial stress ``(2 mu + 3 |lam|) |X| / 2``,
-    ``log_jp`` of ``|log_jp| + |X|``, ``kappa`` of ``kappa + |X|`` (``X = F_tr F_tr^T - I``, in plane strain with
-    its out-of-plane entry ``(1 + h_zz)^2 - 1``)."""
+    ``log_jp`` of ``|log_jp| + |X|``, ``kappa`` (plastic work, J/m^3) of ``kappa`` plus the trial stress scale times
+    ``|X|`` (``X = F_tr F_tr^T - I``, in plane strain with its out-of-plane entry ``(1 + h_zz)^2 - 1``)."""
     H, hzz, lj, kap = inputs
     dim = H.shape[1]
     F = np.eye(dim) + H
     X = np.sqrt(((F @ np.swapaxes(F, 1, 2) - np.eye(dim)) ** 2).sum(axis=(1, 2)) + ((1.0 + hzz) ** 2 - 1.0) ** 2)
-    scales = {"H": np.abs(F).max(axis=(1, 2)), "hzz": 1.0 + np.abs(hzz),
-              "tau": (2.0 * material.mu + 3.0 * abs(material.lam)) * X / 2.0, "log_jp": np.abs(lj) + X,
-              "kappa": kap + X}
+    tau = (2.0 * material.mu + 3.0 * abs(material.lam)) * X / 2.0
+    scales = {"H": np.abs(F).max(axis=(1, 2)), "hzz": 1.0 + np.abs(hzz), "tau": tau, "log_jp": np.abs(lj) + X,
+              "kappa": kap + tau * X}
     out = {}
     for key, sc in scales.items():
         d = np.abs(got[key] - ref[key])
