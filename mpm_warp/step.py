@@ -81,16 +81,18 @@ class Stepper:
         n_nodes = int(np.prod(gs))
         # the kernels see the grid flat (node (i, j[, k]) at i s_0 + j s_1 [+ k]), copy k at k n_nodes
         strides = Vi(*[int(np.prod(gs[a + 1:])) for a in range(dim)])
-        self._grid_m_flat = wp.zeros(nt * n_nodes, dtype=T, device=dev)
-        self._grid_p_flat = wp.zeros(nt * n_nodes, dtype=V, device=dev)
+        # (flat buffers held by the recorded launches and the views below only, so the stepper's own arrays
+        # count the grid once)
+        grid_m_flat = wp.zeros(nt * n_nodes, dtype=T, device=dev)
+        grid_p_flat = wp.zeros(nt * n_nodes, dtype=V, device=dev)
         #: per-thread grid copies (views of the flat buffers): nodal masses (kg) and momenta (kg m/s)
-        self.grid_m_all = self._grid_m_flat.reshape((nt, *gs))
-        self.grid_p_all = self._grid_p_flat.reshape((nt, *gs))
+        self.grid_m_all = grid_m_flat.reshape((nt, *gs))
+        self.grid_p_all = grid_p_flat.reshape((nt, *gs))
         #: summed nodal mass (kg) and, after the grid update, nodal velocity (m/s)
         self.grid_m = self.grid_m_all[0]
         self.grid_p = self.grid_p_all[0]
-        self._grid_copies = [(self._grid_m_flat[k * n_nodes:(k + 1) * n_nodes],
-                              self._grid_p_flat[k * n_nodes:(k + 1) * n_nodes]) for k in range(nt)]
+        self._grid_copies = [(grid_m_flat[k * n_nodes:(k + 1) * n_nodes],
+                              grid_p_flat[k * n_nodes:(k + 1) * n_nodes]) for k in range(nt)]
         self.dt = wp.zeros(1, dtype=T, device=dev)
         self.vmax = wp.zeros(nt, dtype=T, device=dev)
         self.seed_vmax()
@@ -155,7 +157,7 @@ class Stepper:
         for k, (a, b) in enumerate(_chunks(0, rows, nt)):
             self._grid.append(wp.launch(
                 grid_update_kernel(dim, T, has_walls), (b - a) * per_row,
-                inputs=[self._grid_m_flat, self._grid_p_flat, nt, a, seg_len, shape, strides, self.dt, s.clock,
+                inputs=[grid_m_flat, grid_p_flat, nt, a, seg_len, shape, strides, self.dt, s.clock,
                         V(*model.gravity), T(tc.gravity_ramp), T(tc.damping),
                         T(tc.damping_until if tc.damping > 0 else 0.0), T(model.mass_threshold), origin, dx,
                         model.walls_device, wall_point, wall_velocity,
