@@ -216,6 +216,9 @@ def main(argv=None) -> int:
             else:
                 rec = shear_level(SHEAR_CELLS[i], prec, a.device)
             rec["level"] = i
+            data = load(a.results)     # merged into what is there now: another process may have written levels
+            data["environment"] = environment(a.device)
+            have = data["ladders"].setdefault(ladder, [])
             have[:] = [x for x in have if not (x.get("level") == i and x["precision"] == prec)] + [rec]
             have.sort(key=lambda x: (x["precision"], x["level"]))
             data["summary"] = {k: summarise(k, v) for k, v in data["ladders"].items()}
