@@ -24,9 +24,9 @@ whose error is dominated by the spatial error, it also gives the change of the
 measured quantity against the smallest CFL factor (an estimate of the time-
 stepping error) and its order in the CFL factor.
 
-The PST crack speed against the finest run is a fourth problem of the issue;
-it is not run here (see :func:`pst_estimate`: the demo scene is already at its
-coarsest allowed ``dx`` and one halving costs 8x a run of about a minute).
+The snow scenes' ladders (PST critical cut, crack speed, touchdown, collapse;
+shear-test peak, softening slip, collapse) take hours on a CPU and run in
+``error_vs_runtime_snow.py``.
 
 Outputs ``benchmarks/results/error_vs_runtime.json`` (everything, with the
 environment), ``error_vs_runtime.md`` (tables) and ``error_vs_runtime.png``
@@ -155,35 +155,11 @@ def summarise(name: str, dx_runs: list[dict], dt_runs: list[dict]) -> dict:
 
 
 def pst_estimate() -> dict:
-    """Why the PST crack speed is not in the ladder: size of the demo scene and the cost of one halving."""
-    out = {"included": False}
-    try:
-        import mpm_warp as mw
-
-        sc = mw.load_scenario("pst_demo")
-        dx = sc.domain.dx
-        n = sum(math.prod((b.hi[a] - b.lo[a]) / dx for a in range(3)) * b.particles_per_cell**3 for b in sc.blocks)
-        cp = max(m.p_wave_speed for m in sc.materials.values())
-        steps = sc.time.end / (sc.time.cfl * dx / cp)
-        out.update(dx=dx, n_particles=round(n), steps_estimate=round(steps), particle_steps=n * steps)
-        one = None
-        measured = os.path.join(RESULTS, "snow_pst_demo.json")  # written by benchmarks/snow_runs.py, if run
-        if os.path.exists(measured):
-            with open(measured) as fh:
-                m = json.load(fh)
-            one = m.get("stepping_wall_time_s")
-            out.update(measured_run={k: m.get(k) for k in ("n_particles", "steps", "stepping_wall_time_s",
-                                                           "particle_steps_per_s")},
-                       measured_cpu_count=m.get("environment", {}).get("cpu_count"))
-        cost = (f"one run at dx 1.5 cm takes {one:.0f} s of stepping here (benchmarks/results/snow_pst_demo.json), "
-                f"so two levels take ~{9 * one:.0f} s and three ~{73 * one:.0f} s" if one else
-                "a ladder of three dx costs 73x one run")
-        out["note"] = ("pst_demo's dx = 1.5 cm is already the coarsest allowed (2 cells across its 3 cm weak layer, "
-                       "pst.MIN_WEAK_LAYER_CELLS); each halving multiplies the cost by 8 in plane strain (4x "
-                       f"particles, 2x steps): {cost}, over the 5 min budget of this benchmark on this CPU")
-    except Exception as e:  # the PST module is work in progress elsewhere; this is only a note
-        out["note"] = f"pst_demo not loadable here ({type(e).__name__}: {e})"
-    return out
+    """Where the snow scenes' ladders are: not here (hours on a CPU), in ``error_vs_runtime_snow.py``."""
+    return {"included": False,
+            "note": ("the PST (critical cut, crack speed, touchdown, collapse) and shear-test (peak, delta_s, "
+                     "collapse) ladders run in benchmarks/error_vs_runtime_snow.py -> "
+                     "benchmarks/results/error_vs_runtime_snow.{json,png}")}
 
 
 def plot(data: dict, path: str) -> None:
@@ -271,7 +247,7 @@ def markdown(data: dict) -> str:
                                                              "n/a (the change does not fall with C: noise level)"))
         lines.append("")
     pst = data["pst"]
-    lines += ["## PST crack speed (not included)", "", pst.get("note", ""), ""]
+    lines += ["## Snow scenes (not included)", "", pst.get("note", ""), ""]
     if "n_particles" in pst:
         lines += [f"pst_demo: dx {pst['dx']} m, {pst['n_particles']} particles, ~{pst['steps_estimate']} steps, "
                   f"{pst['particle_steps']:.2g} particle-steps per run.", ""]

@@ -7,14 +7,16 @@ against outcome, with the bracket, beside Gaume et al. 2017's formula):
 
 - ``flat``: ``pst_flat`` on a 3 m column;
 - ``slope``: ``pst_slope`` (30 deg) on a 3 m column;
-- ``flat_saw_half``: the saw at half speed (0.5 m/s);
-- ``flat_dx_half``: the grid spacing halved (8 cells across the layer) on a 2.2 m column, checked
-  at 0.8 and 1.2 times the ``flat`` critical cut only (two trials: the issue's 20 % band), each
-  8x the cost of a ``flat`` trial.
+- ``flat_saw_half``: ``flat`` with the saw at half speed (0.5 m/s);
+- ``ladder_saw_half``: the PST of the error-against-run-time ladder at 6 cells across its layer
+  (``benchmarks/error_vs_runtime_snow.py``, level 1, whose critical cut is the reference) with the saw
+  at half speed: the saw-speed check at a tenth of ``flat_saw_half``'s cost. The dx-halving check is
+  that ladder's next level.
+- ``ladder_slope``: that PST on a 30 deg slope (``pst_slope``'s angle).
 
 Usage::
 
-    nohup .venv/bin/python benchmarks/snow_critical_cut.py flat slope flat_saw_half flat_dx_half > cut.log 2>&1 &
+    nohup .venv/bin/python benchmarks/snow_critical_cut.py flat slope ladder_saw_half ladder_slope > cut.log 2>&1 &
 """
 
 from __future__ import annotations
@@ -36,11 +38,15 @@ from mpm_warp.scenes.pst import critical_cut  # noqa: E402
 FIELD_CUT = (0.15, 0.6)   # m: the issue's band for a flat PST (field: a few tens of centimetres)
 #: the column of the bisections: 3 m leaves 1 m of run beyond a 0.8 m cut and the slab's end zone
 COLUMN = ["scene.length=3.0", "scene.marker_spacing=0.1"]
+#: the PST of the error-against-run-time ladder at its level 1 (dx 10 mm, 6 cells across a 6 cm layer)
+LADDER = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
+          "scene.substratum_thickness=0.06", "scene.margin=0.05", "scene.dx=0.01"]
 CASES = {
     "flat": ("pst_flat", COLUMN, dict(lo=0.1, hi=0.8, tol=0.02)),
     "slope": ("pst_slope", COLUMN, dict(lo=0.05, hi=0.8, tol=0.02)),
     "flat_saw_half": ("pst_flat", COLUMN + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.8, tol=0.02)),
-    "flat_dx_half": ("pst_flat", ["scene.length=2.2", "scene.dx=0.00375"], None),   # bracket from "flat"
+    "ladder_saw_half": ("pst_flat", LADDER + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.7, tol=0.02)),
+    "ladder_slope": ("pst_slope", LADDER, dict(lo=0.05, hi=0.7, tol=0.02)),
 }
 OUT = "snow_critical_cut"
 
@@ -83,14 +89,22 @@ def figure(data: dict, path: str) -> None:
     plt.close(fig)
 
 
+def reference(name: str, data: dict) -> float | None:
+    """The critical cut at full saw speed (m): the ``flat`` case, or the ladder's level 1 (float32)."""
+    if name == "flat":
+        return data["cases"].get("flat", {}).get("value")
+    path = os.path.join(RESULTS, "error_vs_runtime_snow.json")
+    if not os.path.isfile(path):
+        return None
+    with open(path) as fh:
+        levels = json.load(fh)["ladders"]["pst"]
+    hit = [lv for lv in levels if lv.get("level") == 1 and lv["precision"] == "float32"]
+    return hit[0]["critical_cut"] if hit else None
+
+
 def run_case(name: str, data: dict, device: str) -> dict:
     scene, overrides, bracket = CASES[name]
     sc = mw.load_scenario(scene, overrides)
-    if bracket is None:        # the 20 % band around the flat case
-        a = data["cases"]["flat"]["value"]
-        if not math.isfinite(a):
-            raise SystemExit("flat_dx_half needs the flat case's critical cut first")
-        bracket = dict(lo=0.8 * a, hi=1.2 * a, tol=0.4 * a)
     t0 = time.perf_counter()
     res = critical_cut(sc, device=device, log=lambda s: print(f"{name}: {s}", flush=True), **bracket)
     wall = time.perf_counter() - t0
@@ -113,11 +127,13 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     data = load()
     for name in a.cases:
-        data["cases"][name] = run_case(name, data, a.device)
-        flat = data["cases"].get("flat")
-        for other in ("flat_saw_half", "flat_dx_half"):
-            if flat and other in data["cases"] and math.isfinite(flat["value"]):
-                data["cases"][other]["change_from_flat"] = data["cases"][other]["value"] / flat["value"] - 1.0
+        case = run_case(name, data, a.device)
+        data = load()                 # merged into what is there now: another process may have written a case
+        data["cases"][name] = case
+        for other, ref in (("flat_saw_half", reference("flat", data)), ("ladder_saw_half", reference("ladder", data))):
+            if other in data["cases"] and ref is not None and math.isfinite(ref):
+                data["cases"][other]["reference_value"] = ref
+                data["cases"][other]["change_from_reference"] = data["cases"][other]["value"] / ref - 1.0
         write_json(OUT, data)
         figure(data, os.path.join(RESULTS, OUT + ".png"))
     return 0 if all(math.isfinite(c["value"]) for c in data["cases"].values()) else 1

@@ -1,9 +1,11 @@
 """Crack speed and critical cut against the weak layer's fracture energy w_f: a Dask sweep (issue 10).
 
-For each ``w_f`` (default 0.1, 0.3, 1.0 J/m^2; the rest of the layer as ``pst_flat``) one Dask task
-bisects the critical cut (:func:`mpm_warp.scenes.pst.critical_cut`, trial runs forked from one base
-run) on a 4 m column; its base run (the saw to ``hi``) runs on into the far end zone, and its mean
-front speed is the crack speed. Tasks run on a local Dask cluster (one worker process per core, one
+For each ``w_f`` (default 0.1, 0.3, 0.79, 1.7 J/m^2: the field's range and the library's default;
+the rest of the layer as ``pst_flat``) one Dask task bisects the critical cut
+(:func:`mpm_warp.scenes.pst.critical_cut`, trial runs forked from one base run) on the PST of the
+error-against-run-time ladder at its 6-cell level (2.2 m column, 0.3 m slab, 6 cm layer, dx 10 mm:
+minutes per case on one core); its base run (the saw to ``hi``) runs on into the far end zone, and
+its mean front speed is the crack speed. Tasks run on a local Dask cluster (one worker process per core, one
 thread each) or on ``--scheduler``. Writes ``benchmarks/results/snow_wf_sweep.json`` and ``.png``
 (speed and critical cut against ``w_f``, beside the field band, Heierli's speed and Gaume et al.
 2017's critical cut, which does not depend on ``w_f``).
@@ -25,7 +27,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from common import RESULTS, environment, write_json  # noqa: E402
 
-COLUMN = ["scene.length=4.0"]
+#: the ladder PST (benchmarks/error_vs_runtime_snow.py) at dx 10 mm, 6 cells across its 6 cm layer
+COLUMN = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
+          "scene.substratum_thickness=0.06", "scene.margin=0.05", "scene.dx=0.01"]
 FIELD_SPEED = (20.0, 30.0)
 FIELD_CUT = (0.15, 0.6)
 
@@ -74,7 +78,8 @@ def figure(rows: list, path: str) -> None:
     ax[1].axhspan(*FIELD_CUT, color="0.88", label="0.15-0.6 m")
     ax[1].set(xscale="log", xlabel="fracture energy w_f [J/m^2]", ylabel="critical cut [m]", title="critical cut")
     ax[1].legend(fontsize=8)
-    fig.suptitle("pst_flat (4 m column): the weak layer's fracture energy swept, everything else fixed", fontsize=9)
+    fig.suptitle("PST (2.2 m column, 0.3 m slab, 6 cm layer at 6 cells): the weak layer's fracture energy swept, "
+                 "everything else fixed", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
@@ -82,9 +87,9 @@ def figure(rows: list, path: str) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--w-f", default="0.1,0.3,1.0", help="fracture energies (J/m^2), comma separated")
+    ap.add_argument("--w-f", default="0.1,0.3,0.79,1.7", help="fracture energies (J/m^2), comma separated")
     ap.add_argument("--lo", type=float, default=0.05)
-    ap.add_argument("--hi", type=float, default=1.0)
+    ap.add_argument("--hi", type=float, default=1.2)
     ap.add_argument("--tol", type=float, default=0.02)
     ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)

@@ -144,7 +144,18 @@ def _summary(res, out=None):
            if res.inversions or res.floor_events else "")
         + (f"\noutput: {res.output}" if res.output else "") + "\n")
     for k, v in res.scene_result.items():
-        out.write(f"  {k}: {v}\n")
+        out.write(f"  {k}: {_short(v)}\n")
+
+
+def _short(v) -> str:
+    """A scene result's value for the summary: numbers with 4 digits, long series by their length (--json has all)."""
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    if isinstance(v, (list, tuple)):
+        return f"[{', '.join(_short(x) for x in v)}]" if len(v) <= 8 else f"({len(v)} values; --json prints them)"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k}: {_short(x)}" for k, x in v.items()) + "}"
+    return str(v)
 
 
 def _stopped(res, path) -> int:

@@ -6,8 +6,8 @@ name               definition                                   unit   reference
 ``collapse``       ``1 - exp(log_jp - log_jp_ref)``: plastic     -      the run's ``log_jp_ref`` field when
                    volume lost since the reference (dilation,           stored (a snow scene with ``log_jp`` in
                    and a sawn cut, are negative)                        its output: the weak layer's state at the
-                                                                        end of settling, or right after a
-                                                                        brittle failure; ``log_jp`` elsewhere),
+                                                                        end of settling; ``log_jp``
+                                                                        elsewhere),
                                                                         else the initial state (frame 0)
 ``displacement``   ``|x - x0|``                                 m      initial positions (static ``x0``)
 ``velocity``       ``|v|``                                      m/s    -
