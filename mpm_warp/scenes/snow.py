@@ -5,20 +5,24 @@ settle it under ramped gravity and grid damping, then run the experiment. ``x`` 
 column, ``y`` is normal to the bed, ``z`` across; a slope of angle ``theta`` is a rotated gravity
 ``g (sin theta, -cos theta)`` (downslope is ``+x``). Scenes are plane strain in true 2D by default
 (``width = 0``: masses, forces and energies per metre of depth); ``width > 0`` builds a free 3D column.
+``plane_strain = "slab"`` runs the same plane-strain problem as the quasi-2D slab instead: a 3D box one
+cell thick in z between slip faces (the check of the true 2D kernels, and their cost against it).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Literal, get_args
 
-from ..checks import finite_number
+from ..checks import choice, finite_number
 from ..config import Domain, TimeControl
 from ..errors import InvalidArgument
 from ..materials import Elastic
 
 __all__ = ["GRAVITY", "Slab", "Settle", "SETTLE_TIME_KEYS", "MIN_WEAK_LAYER_CELLS", "slab_normal_stress",
-           "oedometric_pressure", "slope_gravity", "settle_time", "PlaneBox", "plane_domain", "check_weak_layer_cells"]
+           "oedometric_pressure", "slope_gravity", "settle_time", "PlaneBox", "PlaneStrain", "plane_domain",
+           "check_plane_strain", "check_weak_layer_cells"]
 
 GRAVITY = 9.81
 """Gravitational acceleration (m/s^2)."""
@@ -112,9 +116,15 @@ def settle_time(time: TimeControl, settle: Settle, gravity) -> TimeControl:
                    damping=float(settle.damping), damping_until=float(settle.duration))
 
 
+#: how a plane-strain scene (``width = 0``) is run: "2d", the true 2D kernels (x-y, per metre of depth), or
+#: "slab", the quasi-2D slab (3D, z in ``[0, dx]`` between slip walls: v_z = 0 on every node, each z layer of
+#: particles the 2D scene; 2x the particles and 3x the stencil, per ``dx`` of depth)
+PlaneStrain = Literal["2d", "slab"]
+
+
 @dataclass(frozen=True)
 class PlaneBox:
-    """The box of a snow scene: true 2D plane strain (``width = 0``) or a free 3D column of that width.
+    """The box of a snow scene: true 2D plane strain (``width = 0``), the quasi-2D slab or a free 3D column.
 
     Attributes
     ----------
@@ -122,7 +132,8 @@ class PlaneBox:
     dim : int
         2 (plane strain in x-y) or 3.
     depth : float
-        Extent of the particles in z (m; 1 m of depth in 2D, where masses and forces are per metre).
+        Extent of the particles in z (m; 1 m of depth in 2D, where masses and forces are per metre; ``dx`` in
+        the slab, the column's width in 3D).
     """
 
     domain: Domain
@@ -142,13 +153,26 @@ class PlaneBox:
         return (x, y) if self.dim == 2 else (x, y, 0.0)
 
 
-def plane_domain(lo_xy, hi_xy, dx: float, width: float, margin: float) -> PlaneBox:
-    """The box: plane strain in true 2D (``width = 0``) or a free 3D column of ``width`` (m) with ``margin`` (m)
+def plane_domain(lo_xy, hi_xy, dx: float, width: float, margin: float, plane_strain: PlaneStrain = "2d") -> PlaneBox:
+    """The box: plane strain (``width = 0``) in true 2D or as the quasi-2D slab (``plane_strain = "slab"``: z in
+    ``[0, dx]`` between slip walls, the x-y faces free), or a free 3D column of ``width`` (m) with ``margin`` (m)
     of free space on each side in z."""
+    if width <= 0.0 and plane_strain == "slab":
+        return PlaneBox(Domain((lo_xy[0], lo_xy[1], 0.0), (hi_xy[0], hi_xy[1], dx), dx, boundary="slip",
+                               boundary_faces="z"), 3, float(dx))
     if width <= 0.0:
         return PlaneBox(Domain(tuple(lo_xy), tuple(hi_xy), dx, boundary="none", dimension=2), 2, 1.0)
     return PlaneBox(Domain((lo_xy[0], lo_xy[1], -margin), (hi_xy[0], hi_xy[1], width + margin), dx,
                            boundary="none"), 3, float(width))
+
+
+def check_plane_strain(plane_strain: str, width: float, where: str) -> None:
+    """Raise unless ``plane_strain`` is one of :data:`PlaneStrain` and, as the slab, comes with ``width = 0``."""
+    choice(f"{where}.plane_strain", plane_strain, get_args(PlaneStrain))
+    if plane_strain == "slab" and width > 0.0:
+        raise InvalidArgument(f"{where}.plane_strain", plane_strain,
+                              f"'2d' when {where}.width = {width:g} m > 0 (a 3D column; the slab is plane strain, "
+                              "width = 0)")
 
 
 def check_weak_layer_cells(d_wl: float, dx: float, where: str) -> None:

@@ -32,7 +32,8 @@ def build(params: PSTParams, time: TimeControl, output: Output | None = None, *,
     dx, L, D, d_wl, d_sub = p.dx, p.length, p.slab_thickness, p.weak_layer_thickness, p.substratum_thickness
     materials = {"slab": p.slab.material(), "weak_layer": p.calibrated().material,
                  "substratum": p.substratum.material()}
-    box = plane_domain((-p.margin, 0.0), (L + p.margin, p.base_y + D + p.margin), dx, p.width, p.margin)
+    box = plane_domain((-p.margin, 0.0), (L + p.margin, p.base_y + D + p.margin), dx, p.width, p.margin,
+                       p.plane_strain)
     ppc = p.particles_per_cell
     blocks = (Block("substratum", box.corner(0.0, 0.0), box.far_corner(L, d_sub), particles_per_cell=ppc,
                     name="substratum"),
@@ -44,7 +45,8 @@ def build(params: PSTParams, time: TimeControl, output: Output | None = None, *,
     bed = Wall(box.vector(0.0, 0.0), box.vector(0.0, 1.0), kind=p.bed, friction=friction, name="bed")
     desc = description or (f"PST: L = {L:g} m, slab {D:g} m on a {d_wl * 100:g} cm weak layer, slope "
                            f"{p.slope_angle:g} deg, cut {p.saw.cut_length:g} m at {p.saw.speed:g} m/s"
-                           + (", plane strain" if box.dim == 2 else f", {p.width:g} m wide"))
+                           + (", plane strain" if box.dim == 2 else ", plane strain (quasi-2D slab)"
+                              if p.width <= 0.0 else f", {p.width:g} m wide"))
     return Scenario(name=name, domain=box.domain,
                     time=settle_time(time, p.settle, slope_gravity(p.slope_angle, box.dim)),
                     materials=materials, blocks=blocks, walls=(bed,), output=output or Output(),

@@ -66,7 +66,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         #: index of each marker's particle within the slab group (the base row, nearest to the middle in z)
         zsel = base
         if x0.shape[1] == 3:
-            zmid = 0.5 * float(p.width)
+            zmid = 0.5 * float(p.width)  # the quasi-2D slab (width 0): its first layer, nearest z = 0
             dz = np.abs(x0[base, 2] - zmid)
             zsel = base[dz <= dz.min() + 1e-6]
         self.marker_index = zsel[np.argmin(np.abs(x0[zsel, 0][None, :] - self.markers[:, None]), axis=1)]

@@ -11,7 +11,15 @@ import numpy as np
 from ...checks import check_choices, finite_number, positive_int
 from ...walls import WallKind
 from ..references import heierli_speed, heierli_touchdown
-from ..snow import Settle, Slab, check_weak_layer_cells, oedometric_pressure, slab_normal_stress
+from ..snow import (
+    PlaneStrain,
+    Settle,
+    Slab,
+    check_plane_strain,
+    check_weak_layer_cells,
+    oedometric_pressure,
+    slab_normal_stress,
+)
 from ..weak_layer import CalibratedWeakLayer, WeakLayer
 
 __all__ = ["Saw", "Front", "PSTParams"]
@@ -82,7 +90,11 @@ class PSTParams:
     slope_angle : float
         Slope (deg), in [-60, 60]: gravity ``g (sin, -cos)``.
     width : float
-        Column width (m); 0 = plane strain in true 2D (quantities per metre of depth).
+        Column width (m); 0 = plane strain (quantities per metre of depth in true 2D).
+    plane_strain : {"2d", "slab"}
+        How plane strain (``width = 0``) is run: "2d", the true 2D kernels (the default), or "slab", the
+        quasi-2D slab (3D, one cell thick in z between slip walls, 2 particle layers at 2 per cell and axis;
+        each layer is the 2D run, at about 5x its cost). "slab" needs ``width = 0``.
     bed : {"sticky", "slip", "separate"}
         Wall kind under the substratum ("separate": Coulomb contact with ``bed_friction``).
     bed_friction : float
@@ -106,6 +118,7 @@ class PSTParams:
     substratum_thickness: float = 0.15
     slope_angle: float = 0.0
     width: float = 0.0
+    plane_strain: PlaneStrain = "2d"
     bed: WallKind = "sticky"
     bed_friction: float = 0.5
     margin: float = 0.05
@@ -129,6 +142,7 @@ class PSTParams:
         finite_number(f"{where}.substratum_thickness", self.substratum_thickness, lo=2.0 * dx)
         finite_number(f"{where}.slope_angle", self.slope_angle, lo=-60.0, hi=60.0)
         finite_number(f"{where}.width", self.width, lo=0.0)
+        check_plane_strain(self.plane_strain, self.width, where)
         finite_number(f"{where}.margin", self.margin, lo=2.0 * dx)
         finite_number(f"{where}.bed_friction", self.bed_friction, lo=0.0)
         finite_number(f"{where}.marker_spacing", self.marker_spacing, lo=0.0, lo_open=True)
