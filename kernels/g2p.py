@@ -29,7 +29,7 @@ def _fma_options(dim):
     default contraction (``-ffp-contract=on``: within one expression) never fuses;
     ``-ffp-contract=fast`` fuses across statements: one rounding instead of two per multiply-add
     (round-off only, the same answer on every run and thread count). The 2D G2P is bound by
-    scalar floating-point throughput on the CPU (about 20 % faster with FMAs at 65k particles).
+    scalar floating-point throughput on the CPU (1.50 -> 1.25 ms with FMAs at 65k particles).
     P2G keeps Warp's default: it evaluates the constitutive update, which must stay bit for bit
     the material-point driver's (``tests/test_constitutive.py``), and the compiler's fusion
     choices depend on the code around the update. The 3D kernels keep the default too.
