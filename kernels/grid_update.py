@@ -22,6 +22,9 @@ once: the gravity increment per thread, the walls' positions and velocities per
 step (:func:`wall_state_kernel`), and the speed bound per thread (the largest
 squared speed of its nodes, one square root and one atomic max at the end;
 ``sqrt`` is monotonic and correctly rounded, so this is the largest speed).
+The wall tests run only at the ends of a row: the nodes of a row inside a wall
+form a prefix or a suffix of it (see the kernel), so a thread tests nodes from
+each end until one lies in no wall, and the nodes between skip the wall loop.
 """
 
 import functools
@@ -102,6 +105,24 @@ def wall_state_kernel(T, dim=3):
 
 
 @functools.cache
+def in_wall_func(T, dim=3):
+    """Return ``in_wall(x, point, normal, dx) -> bool``: the node at ``x`` (m) lies in the wall through ``point``.
+
+    Nodes on the plane belong to the wall; the ``1e-3 dx`` margin absorbs the rounding of ``origin + i dx``.
+    Along a row of nodes (one coordinate of ``x`` moving with the index) the rounded signed distance
+    ``(x - point) . normal`` is monotonic in the index (each of its operations is), so the nodes of a row in
+    one wall are a prefix, a suffix, all or none of the row.
+    """
+    V = vec(dim, T)
+
+    @wp.func
+    def in_wall(xn: V, point: V, nrm: V, dx: T):
+        return wp.dot(xn - point, nrm) <= T(1.0e-3) * dx
+
+    return in_wall
+
+
+@functools.cache
 def grid_update_kernel(dim, T, has_walls: bool):
     """Build the grid update kernel for dimension ``dim``.
 
@@ -123,6 +144,15 @@ def grid_update_kernel(dim, T, has_walls: bool):
     Vi = wp.types.vector(dim, wp.int32)
     WallParams = wall_struct(T, dim)
     last = dim - 1
+    in_wall = in_wall_func(T, dim)
+
+    @wp.func
+    def in_any_wall(xn: V, walls: wp.array(dtype=WallParams), wall_point: wp.array(dtype=V), dx: T):
+        inside = int(0)
+        for w in range(walls.shape[0]):
+            if in_wall(xn, wall_point[w], walls[w].normal, dx):
+                inside = 1
+        return inside != 0
 
     @wp.kernel(enable_backward=False, module="unique")
     def grid_update(
@@ -183,6 +213,21 @@ def grid_update_kernel(dim, T, has_walls: bool):
         damped = t < damping_until
         damp = wp.max(T(1.0) - damping * dt, T(0.0))
         v2max = T(0.0)
+        # the nodes of the segment inside some wall are a prefix and/or a suffix of it (in_wall_func): between
+        # the first and the last node in no wall none is in any wall, and those nodes skip the wall loop
+        kl = k0
+        kh = k1 - 1
+        if wp.static(has_walls):
+            while kl <= kh:
+                xn[last] = origin[last] + T(kl) * dx
+                if not in_any_wall(xn, walls, wall_point, dx):
+                    break
+                kl += 1
+            while kh > kl:
+                xn[last] = origin[last] + T(kh) * dx
+                if not in_any_wall(xn, walls, wall_point, dx):
+                    break
+                kh -= 1
         for k in range(k0, k1):
             n = first + k
             m = grid_m[n]
@@ -197,30 +242,30 @@ def grid_update_kernel(dim, T, has_walls: bool):
             if damped:
                 vel = vel * damp
             if wp.static(has_walls):
-                xn[last] = origin[last] + T(k) * dx
-                for w in range(walls.shape[0]):
-                    nrm = walls[w].normal
-                    # nodes on the plane belong to the wall; the 1e-3 dx margin absorbs the rounding of origin + i dx
-                    if wp.dot(xn - wall_point[w], nrm) <= T(1.0e-3) * dx:
-                        kind = walls[w].kind
-                        vw = wall_velocity[w]
-                        v_old = vel
-                        vrel = vel - vw
-                        vn = wp.dot(vrel, nrm)
-                        if kind == 0:
-                            vrel = V()
-                        elif kind == 1:
-                            vrel = vrel - vn * nrm
-                        elif vn < T(0.0):
-                            mu = walls[w].friction
-                            vt = vrel - vn * nrm
-                            vt_norm = wp.length(vt)
-                            if vt_norm <= -mu * vn:
+                if k < kl or k > kh:
+                    xn[last] = origin[last] + T(k) * dx
+                    for w in range(walls.shape[0]):
+                        nrm = walls[w].normal
+                        if in_wall(xn, wall_point[w], nrm, dx):
+                            kind = walls[w].kind
+                            vw = wall_velocity[w]
+                            v_old = vel
+                            vrel = vel - vw
+                            vn = wp.dot(vrel, nrm)
+                            if kind == 0:
                                 vrel = V()
-                            else:
-                                vrel = vt * (T(1.0) + mu * vn / vt_norm)
-                        vel = vw + vrel
-                        wp.atomic_add(wall_impulse, w, VD(m * (v_old - vel)))
+                            elif kind == 1:
+                                vrel = vrel - vn * nrm
+                            elif vn < T(0.0):
+                                mu = walls[w].friction
+                                vt = vrel - vn * nrm
+                                vt_norm = wp.length(vt)
+                                if vt_norm <= -mu * vn:
+                                    vrel = V()
+                                else:
+                                    vrel = vt * (T(1.0) + mu * vn / vt_norm)
+                            vel = vw + vrel
+                            wp.atomic_add(wall_impulse, w, VD(m * (v_old - vel)))
             grid_p[n] = vel
             v2max = wp.max(v2max, wp.dot(vel, vel))
         wp.atomic_max(vmax, 0, wp.sqrt(v2max))

@@ -29,7 +29,7 @@ import functools
 import warp as wp
 
 from .constitutive import FLOORED, INVERTED, YIELDED, constitutive_update_func, material_struct, trial_func
-from .shape import in_grid_func, stencil_func
+from .shape import NONNEG, in_grid_func, stencil_func
 from .types import mat, vec
 
 
@@ -119,18 +119,38 @@ def p2g_kernel(dim, T, model, track_yield):
         if not in_grid(b, shape):
             wp.atomic_add(counts, 1, 1)
             return
-        n0 = b[0] * strides[0] + b[1] * strides[1]
-        if wp.static(dim == 3):
-            n0 += b[2]
-        for a in range(3):
-            for c in range(3):
-                if wp.static(dim == 2):
-                    n = n0 + a * strides[0] + c
-                    w = W[a, 0] * W[c, 1]
-                    dpos = (V(T(float(a)), T(float(c))) - fx) * dx
-                    grid_m[n] += w * mass
-                    grid_p[n] += w * (mv + A * dpos)
-                else:
+        if wp.static(dim == 2):
+            # (masking the sign bit, a no-op on the in-grid indices, tells the compiler they are not negative: no
+            # negative-index wrap per access)
+            s0 = strides[0] & NONNEG
+            n0 = (b[0] * s0 + b[1] * strides[1]) & NONNEG
+            # A dpos = A[:, 0] dpos_x + A[:, 1] dpos_y (Warp's order), its column terms formed once per stencil
+            # row and column: the same sums in the same order as the per-node product, bit for bit
+            a0 = V(A[0, 0], A[1, 0])
+            a1 = V(A[0, 1], A[1, 1])
+            cy0 = a1 * ((T(0.0) - fx[1]) * dx)
+            cy1 = a1 * ((T(1.0) - fx[1]) * dx)
+            cy2 = a1 * ((T(2.0) - fx[1]) * dx)
+            wy0 = W[0, 1]
+            wy1 = W[1, 1]
+            wy2 = W[2, 1]
+            for a in range(3):
+                na = n0 + a * s0
+                wa = W[a, 0]
+                cx = a0 * ((T(float(a)) - fx[0]) * dx)
+                w = wa * wy0
+                grid_m[na] += w * mass
+                grid_p[na] += w * (mv + (cx + cy0))
+                w = wa * wy1
+                grid_m[na + 1] += w * mass
+                grid_p[na + 1] += w * (mv + (cx + cy1))
+                w = wa * wy2
+                grid_m[na + 2] += w * mass
+                grid_p[na + 2] += w * (mv + (cx + cy2))
+        else:
+            n0 = b[0] * strides[0] + b[1] * strides[1] + b[2]
+            for a in range(3):
+                for c in range(3):
                     for d in range(3):
                         n = n0 + a * strides[0] + c * strides[1] + d
                         w = W[a, 0] * W[c, 1] * W[d, 2]

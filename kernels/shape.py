@@ -17,6 +17,11 @@ import warp as wp
 
 from .types import vec, weights
 
+#: int32 sign-bit mask: ``n & NONNEG == n`` for every index ``n >= 0``. A kernel that masks a flat grid index
+#: it knows to be in the grid tells the compiler the index is not negative: Warp's array access then drops
+#: its negative-index wrap (a compare and a select per access).
+NONNEG = wp.constant(0x7FFFFFFF)
+
 
 @functools.cache
 def stencil_func(T, dim=3):

@@ -255,3 +255,91 @@ def test_wall_kinds_are_one_tuple_matching_the_kernel_codes():
     assert WALL_KINDS == ("sticky", "slip", "separate")
     assert [mw.Wall((0, 0, 0), (0, 1, 0), kind=k).kind_id for k in WALL_KINDS] == [STICKY, SLIP, SEPARATE]
     assert BOUNDARIES == (*WALL_KINDS, "none")
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("seg_len", ["row", 1])
+def test_grid_update_skips_wall_tests_only_where_no_wall_holds(dim, seg_len):
+    """The grid update tests walls only from the ends of each row; every node it skips lies in no wall.
+
+    Sticky walls at rest set a node's velocity to exactly zero and every other node keeps a nonzero
+    velocity (random momenta, no gravity), so the zeroed nodes must be exactly those that
+    ``in_wall_func`` puts in some wall, node by node: walls at both ends of the rows, tilted walls that
+    cut rows in their middle (float32 rounding of the signed distance decides), a wall parallel to the
+    rows, and a wall holding no node.
+    """
+    import warp as wp
+
+    from mpm_warp.kernels.grid_update import grid_update_kernel, in_wall_func, wall_struct
+    from mpm_warp.kernels.types import vec
+
+    T = wp.float32
+    V = vec(dim, T)
+    shape = (13, 17) if dim == 2 else (7, 9, 11)
+    dx = 0.1
+    origin = np.array([-0.3, 0.2, 0.1][:dim])
+    hi = origin + dx * (np.array(shape) - 1)
+    n_last = shape[-1]
+    planes = [  # (point, normal): box faces at both ends of the rows, tilted cuts, a wall along the rows, none
+        (origin + 2 * dx * np.eye(dim)[-1], np.eye(dim)[-1]),
+        (hi - 3 * dx * np.eye(dim)[-1], -np.eye(dim)[-1]),
+        (origin + 0.37 * (hi - origin), np.r_[np.ones(dim - 1), 0.7]),
+        (origin + 0.61 * (hi - origin), -np.r_[np.full(dim - 1, 0.3), 1.0]),
+        (origin + 1.0 * dx * np.eye(dim)[0], np.eye(dim)[0]),
+        (hi + 5 * dx, -np.ones(dim)),
+    ]
+    WallParams = wall_struct(T, dim)
+    walls = []
+    for p, nrm in planes:
+        w = WallParams()
+        w.point = V(*p)
+        w.normal = V(*(nrm / np.linalg.norm(nrm)))
+        w.velocity = V()
+        w.kind = 0
+        walls.append(w)
+    nw = len(walls)
+    walls_d = wp.array(walls, dtype=WallParams, device="cpu")
+    wall_point = wp.array([w.point for w in walls], dtype=V, device="cpu")
+    n_nodes = int(np.prod(shape))
+    rng = np.random.default_rng(7)
+    mom = rng.uniform(0.5, 1.5, (n_nodes, dim)) * rng.choice([-1.0, 1.0], (n_nodes, dim))
+    grid_m = wp.array(np.ones(n_nodes), dtype=T, device="cpu")
+    grid_p = wp.array(mom.astype(np.float32), dtype=V, device="cpu")
+    strides = [int(np.prod(shape[a + 1:])) for a in range(dim)]
+    rows = n_nodes // n_last
+    seg = n_last if seg_len == "row" else 1
+    Vi = wp.types.vector(dim, wp.int32)
+    wp.launch(grid_update_kernel(dim, T, True), rows * (n_last // seg),
+              inputs=[grid_m, grid_p, 1, 0, seg, Vi(*shape), Vi(*strides), wp.array([1e-3], dtype=T, device="cpu"),
+                      wp.zeros(4, dtype=wp.float64, device="cpu"), V(), T(0.0), T(0.0), T(0.0), T(0.0), V(*origin),
+                      T(dx), walls_d, wall_point, wp.zeros(nw, dtype=V, device="cpu"),
+                      wp.zeros(nw, dtype=vec(dim, wp.float64), device="cpu"), wp.zeros(1, dtype=T, device="cpu")],
+              device="cpu")
+    in_wall = in_wall_func(T, dim)
+
+    def membership(walls, wall_point, origin, dx, strides, out):
+        n = wp.tid()
+        xn = V()
+        r = n
+        for a in range(dim):
+            i = r / strides[a]
+            r = r - i * strides[a]
+            xn[a] = origin[a] + T(i) * dx
+        for w in range(walls.shape[0]):
+            if in_wall(xn, wall_point[w], walls[w].normal, dx):
+                out[n] = 1
+
+    # (annotations set as objects: this file's postponed annotations would be strings naming locals)
+    membership.__annotations__ = {"walls": wp.array(dtype=WallParams), "wall_point": wp.array(dtype=V), "origin": V,
+                                  "dx": T, "strides": Vi, "out": wp.array(dtype=wp.int32)}
+    membership = wp.kernel(membership, enable_backward=False, module="unique")
+    inside = wp.zeros(n_nodes, dtype=wp.int32, device="cpu")
+    wp.launch(membership, n_nodes, inputs=[walls_d, wall_point, V(*origin), T(dx), Vi(*strides), inside],
+              device="cpu")
+    inside = inside.numpy().astype(bool)
+    zeroed = np.all(grid_p.numpy() == 0.0, axis=1)
+    # every kind of row occurs: all nodes in walls, wall nodes at one or both ends, cut in the middle
+    per_row = inside.reshape(rows, n_last)
+    assert per_row.all(axis=1).any() and (per_row.any(axis=1) & ~per_row.all(axis=1)).sum() > rows // 4
+    assert (per_row[:, 0] & per_row[:, -1] & ~per_row.all(axis=1)).any()
+    np.testing.assert_array_equal(zeroed, inside)
