@@ -65,7 +65,9 @@ def figure(rows: list, path: str) -> None:
 
     w = [r["w_f"] for r in rows]
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
-    ax[0].plot(w, [r["speed"] for r in rows], "o-", color="C3", label="damage front, mean from the cut")
+    cut = rows[0]["speed_over"][0]  # the base run saws to the top of the bracket
+    ax[0].plot(w, [r["speed"] for r in rows], "o-", color="C3",
+               label=f"damage front, mean from the base run's {cut:g} m cut")
     ax[0].plot(w, [r["heierli_speed_run"] for r in rows], "s--", color="C2", label="Heierli (run's collapse)")
     ax[0].axhspan(*FIELD_SPEED, color="0.88", label="field 20-30 m/s")
     ax[0].set(xscale="log", xlabel="fracture energy w_f [J/m^2]", ylabel="crack speed [m/s]", title="speed")
@@ -73,6 +75,10 @@ def figure(rows: list, path: str) -> None:
     for r in rows:
         ax[1].plot([r["w_f"]] * 2, [r["lo"], r["hi"]], "-", color="C0", lw=4, alpha=0.5)
     ax[1].plot(w, [r["critical_cut"] for r in rows], "o-", color="C0", label="bisection (bar: bracket)")
+    for r in rows:
+        if not math.isfinite(r["critical_cut"]):
+            ax[1].annotate(f"no crack from a\n{r['hi']:g} m cut", (r["w_f"], r["hi"]), xytext=(-70, -30),
+                           textcoords="offset points", fontsize=8, arrowprops=dict(arrowstyle="->"))
     ax[1].plot(w, [r["critical_cut_gaume"] for r in rows], "D:", color="C2", mfc="none",
                label="Gaume et al. 2017 (no w_f)")
     ax[1].axhspan(*FIELD_CUT, color="0.88", label="0.15-0.6 m")
