@@ -85,8 +85,18 @@ def figure(res: dict, profiles: list[dict], path: str) -> None:
                   label=f"Heierli, run's h_c: {r['heierli_speed_run']:.3g} m/s")
     ax[1].axhline(r["shear_wave_speed"], color="0.4", ls=":", label=f"slab c_s {r['shear_wave_speed']:.3g} m/s")
     ax[1].axhline(0.6 * r["shear_wave_speed"], color="0.6", ls=":", label="0.6 c_s")
+    ax[1].axhline(r["rayleigh_speed"], color="C1", ls=":", label=f"slab Rayleigh c_R {r['rayleigh_speed']:.3g} m/s")
+    # up to the end zone (the last slab thickness, where the far end's own failure spoils a speed)
+    s_max = r["column_length"] - max(float(res["scene_slab_thickness"]), 0.0)
+    top = 1.1 * r["shear_wave_speed"]
+    for key in ("damage", "deflection"):
+        prof = r[f"{key}_speed_profile"]
+        inside = [v for x, v in zip(prof["s"], prof["speed"], strict=True) if x <= s_max and math.isfinite(v)]
+        if inside:
+            top = max(top, min(1.05 * max(inside), 2.0 * r["shear_wave_speed"]))
+    ax[1].axvspan(s_max, r["column_length"], color="0.93", zorder=0, label="end zone (one slab thickness)")
     ax[1].set(xlabel="distance from the cut end [m]", ylabel="local front speed [m/s] (0.5 m windows)",
-              title="crack speed along the column", ylim=(0, 1.1 * r["shear_wave_speed"]))
+              title="crack speed along the column", ylim=(0, top))
     ax[1].legend(fontsize=7)
     h_c = r["collapse_height_calibrated"]
     for prof in profiles:
@@ -127,7 +137,8 @@ def main(argv=None) -> int:
     wall = time.perf_counter() - t0 + a.prior_wall_s
     mon = rr.monitor
     keep = ("front", "deflection_front", "saw", "collapse_height", "touchdown")
-    res = {"name": name, "scenario": a.scene, "overrides": a.overrides, "description": sc.description,
+    res = {"name": name, "scenario": a.scene, "scene_slab_thickness": sc.scene.slab_thickness,
+           "overrides": a.overrides, "description": sc.description,
            "environment": environment(a.device), "wall_s": wall,
            "resumed": bool(a.resume), "steps": rr.steps, "particles": rr.n_particles,
            "particle_steps_per_s": rr.particle_steps_per_s, "h5": h5,
