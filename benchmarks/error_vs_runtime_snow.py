@@ -170,6 +170,11 @@ def figure(data: dict, path: str) -> None:
         ax.set(xlabel="wall time of the level [s] (CPU, 2D, float32)", ylabel="relative error",
                title=f"{ladder}: dx halving, " + ", ".join(f"{x['cells_across_layer']:.0f}" for x in lv)
                      + " cells across the layer")
+        # levels without a value (e.g. a PST whose crack does not run) are said, not silently left out
+        missing = [f"{x['cells_across_layer']:.0f} cells: {x['note']}" for x in lv if x.get("note")]
+        if missing:
+            ax.text(0.02, 0.02, "\n".join(missing), transform=ax.transAxes, fontsize=8, va="bottom")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         if drawn:
             ax.legend(fontsize=8)
     fig.tight_layout()

@@ -12,7 +12,10 @@ against outcome, with the bracket, beside Gaume et al. 2017's formula):
   (``benchmarks/error_vs_runtime_snow.py``, level 1, whose critical cut is the reference) with the saw
   at half speed: the saw-speed check at a tenth of ``flat_saw_half``'s cost. The dx-halving check is
   that ladder's next level.
-- ``ladder_slope``: that PST on a 30 deg slope (``pst_slope``'s angle).
+- ``ladder_slope``: that PST on a 30 deg slope (``pst_slope``'s angle), the saw cutting from the
+  upslope end (the crack runs downslope);
+- ``ladder_slope_cut_downslope_end``: the same with the slope reversed (-30 deg): the saw cuts from the
+  downslope end and the crack runs upslope.
 
 Usage::
 
@@ -47,6 +50,8 @@ CASES = {
     "flat_saw_half": ("pst_flat", COLUMN + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.8, tol=0.02)),
     "ladder_saw_half": ("pst_flat", LADDER + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.7, tol=0.02)),
     "ladder_slope": ("pst_slope", LADDER, dict(lo=0.05, hi=0.7, tol=0.02)),
+    "ladder_slope_cut_downslope_end": ("pst_slope", LADDER + ["scene.slope_angle=-30.0"],
+                                       dict(lo=0.05, hi=0.7, tol=0.02)),
 }
 OUT = "snow_critical_cut"
 
@@ -70,10 +75,26 @@ def load() -> dict:
     return {"cases": {}}
 
 
+def ladder_rows() -> dict:
+    """The ladder PST's own bisections (``error_vs_runtime_snow.json``): the references of the ``ladder_*`` cases."""
+    path = os.path.join(RESULTS, "error_vs_runtime_snow.json")
+    if not os.path.isfile(path):
+        return {}
+    with open(path) as fh:
+        levels = json.load(fh)["ladders"]["pst"]
+    out = {}
+    for lv in levels:
+        if lv["precision"] == "float32" and lv.get("bracketed"):
+            lo, hi = lv["critical_cut_bracket"]
+            out[f"ladder, dx {1e3 * lv['dx']:g} mm (error ladder)"] = {"trials": lv["trials"], "lo": lo, "hi": hi}
+    return out
+
+
 def figure(data: dict, path: str) -> None:
+    """Every case's trials (and the ladder PST's own bisections, its references), bracket and Gaume's value."""
     plt = _plt()
-    cases = data["cases"]
-    fig, ax = plt.subplots(figsize=(8, 0.9 + 0.7 * len(cases)))
+    cases = {**ladder_rows(), **data["cases"]}
+    fig, ax = plt.subplots(figsize=(9, 1.3 + 0.55 * len(cases)))
     for i, c in enumerate(cases.values()):
         for tr in c["trials"]:
             ax.plot(tr["cut"], i, "o" if tr["propagated"] else "x", color="C3" if tr["propagated"] else "C0", ms=7)
@@ -82,8 +103,8 @@ def figure(data: dict, path: str) -> None:
             ax.plot(c["gaume"], i, "D", color="C2", ms=7, mfc="none")
     ax.axvspan(*FIELD_CUT, color="0.9", zorder=0)
     ax.set_yticks(range(len(cases)), list(cases))
-    ax.set(xlabel="saw cut length [m]", title="critical cut: x arrested, o propagated, bar = bracket, "
-                                             "diamond = Gaume et al. 2017, grey = 0.15-0.6 m")
+    ax.set(xlabel="saw cut length [m]", title="critical cut: x arrested, o propagated, bar = bracket,\n"
+                                             "diamond = Gaume et al. 2017 (flat formula), grey = 0.15-0.6 m")
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
