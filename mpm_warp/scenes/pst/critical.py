@@ -128,13 +128,13 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
     snaps = []                               # (blade position, snapshot), increasing
     sim.step_to(t_saw)
     a = min(lo, hi)                          # no trial starts before lo
-    sim.step_to(t_saw + a / v)
+    _step_recording(sim, mon, t_saw + a / v, check_interval)
     while True:
         snaps.append((a, sim.snapshot()))
         if a >= hi:
             break
         a = min(a + step, hi)
-        sim.step_to(t_saw + a / v)
+        _step_recording(sim, mon, t_saw + a / v, check_interval)
     base = _trial(sim, mon, hi, run_distance if base_run_distance is None else base_run_distance,
                   free_run if base_free_run is None else base_free_run, check_interval)
     base_summary = mon.result()
@@ -167,6 +167,19 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
                            bracketed=False, note=why)
     b = bisect_threshold(propagates, lo, hi, tol, check_ends=False)
     return CriticalCut(b.value, b.lo, b.hi, trials, runaway, base_summary, _time.perf_counter() - wall0)
+
+
+def _step_recording(sim: Simulation, mon: PSTMonitor, t_end: float, check_interval: float) -> None:
+    """Step ``sim`` to ``t_end`` (s) with a frame of the monitor's series every ``check_interval`` (s) on the way.
+
+    A crack may run away while the saw is still cutting towards the base run's ``hi``: without these
+    frames the base summary would have no frame of its run (no touchdown, no collapse history).
+    """
+    t = sim.time
+    while t < t_end - 1e-12:
+        t = min(t + check_interval, t_end)
+        sim.step_to(t)
+        mon.frame_scalars(sim)
 
 
 def _trial(sim: Simulation, mon: PSTMonitor, cut: float, run_distance: float, free_run: float,
