@@ -102,7 +102,11 @@ def figure(data: dict, path: str) -> None:
         if c.get("gaume") is not None:
             ax.plot(c["gaume"], i, "D", color="C2", ms=7, mfc="none")
     ax.axvspan(*FIELD_CUT, color="0.9", zorder=0)
-    ax.set_yticks(range(len(cases)), list(cases))
+    labels = {"flat": "pst_flat (3 m column, 4 cells)", "slope": "pst_slope (3 m column, 4 cells)",
+              "flat_saw_half": "pst_flat, saw 0.5 m/s", "ladder_saw_half": "ladder, saw 0.5 m/s",
+              "ladder_slope": "ladder, 30 deg, cut from the upslope end",
+              "ladder_slope_cut_downslope_end": "ladder, 30 deg, cut from the downslope end"}
+    ax.set_yticks(range(len(cases)), [labels.get(k, k) for k in cases])
     ax.set(xlabel="saw cut length [m]", title="critical cut: x arrested, o propagated, bar = bracket,\n"
                                              "diamond = Gaume et al. 2017 (flat formula), grey = 0.15-0.6 m")
     fig.tight_layout()
