@@ -14,7 +14,7 @@ import functools
 import warp as wp
 
 from .constitutive import material_struct
-from .elasticity import hencky_strain_energy_func, hencky_strain_func
+from .elasticity import cauchy_from_principal_func, hencky_strain_energy_func, hencky_strain_func
 from .principal import principal_strain_func
 from .types import mat, vec
 
@@ -71,6 +71,7 @@ def stress_kernel(dim, T):
     P = material_struct(T)
     principal_strain = principal_strain_func(D, dim)
     hencky = hencky_strain_func(D)
+    cauchy_of = cauchy_from_principal_func(T, dim)
 
     @wp.kernel(enable_backward=False, module="unique")
     def stress(H: wp.array(dtype=M), hzz: wp.array(dtype=T), log_jp: wp.array(dtype=T), m: P, want_sigma: int,
@@ -91,17 +92,7 @@ def stress_kernel(dim, T):
             ln_j = eps[0] + eps[1] + eps[2]
             if log_jp.shape[0] > 0:
                 ln_j += D(log_jp[i]) - D(m.log_jp_ref)
-            J = wp.exp(ln_j)
-            sig = M3()
-            for a in range(dim):
-                for b in range(dim):
-                    acc = D(0.0)
-                    for k in range(dim):
-                        acc += U[a, k] * tau[k] * U[b, k]
-                    sig[a, b] = T(acc / J)
-            if wp.static(dim == 2):
-                sig[2, 2] = T(tau[2] / J)
-            sigma_out[i] = sig
+            sigma_out[i] = cauchy_of(U, tau, wp.exp(ln_j))
 
     return stress
 

@@ -18,7 +18,7 @@ import functools
 
 import warp as wp
 
-from .types import vec3
+from .types import mat, vec, vec3
 
 __all__ = ["clamp_singular_func", "hencky_func", "hencky_energy_func", "hencky_strain_func",
            "hencky_strain_energy_func"]
@@ -109,6 +109,35 @@ def hencky_strain_func(T):
         return v3(two_mu * eps[0] + lam * tr, two_mu * eps[1] + lam * tr, two_mu * eps[2] + lam * tr)
 
     return hencky_strain
+
+
+@functools.cache
+def cauchy_from_principal_func(T, dim):
+    """Build ``cauchy(U, tau, J) -> mat33 of T``: the Cauchy stress ``U diag(tau) U^T / J`` (Pa).
+
+    ``U`` (float64, ``dim x dim``) holds the principal directions, ``tau`` (float64, 3) the principal
+    Kirchhoff stresses (Pa), ``J`` (float64) the volume ratio. In plane strain (``dim == 2``) the
+    in-plane block is rotated and ``sigma_zz = tau_z / J``; ``sigma_xz = sigma_yz = 0``.
+    """
+    D = wp.float64
+    MD = mat(dim, D)
+    V3 = vec(3, D)
+    M3 = mat(3, T)
+
+    @wp.func
+    def cauchy(U: MD, tau: V3, J: D):
+        sig = M3()
+        for a in range(dim):
+            for b in range(dim):
+                acc = D(0.0)
+                for k in range(dim):
+                    acc += U[a, k] * tau[k] * U[b, k]
+                sig[a, b] = T(acc / J)
+        if wp.static(dim == 2):
+            sig[2, 2] = T(tau[2] / J)
+        return sig
+
+    return cauchy
 
 
 @functools.cache

@@ -26,7 +26,7 @@ import warp as wp
 from .bonded_camclay import bonded_p0_func
 from .camclay import camclay_p0_func
 from .constitutive import constitutive_update_func, material_struct, trial_func
-from .elasticity import hencky_strain_func
+from .elasticity import cauchy_from_principal_func, hencky_strain_func
 from .principal import principal_strain_func
 from .types import mat, vec
 
@@ -50,6 +50,7 @@ def drive_kernel(dim, T, model):
     MD = mat(dim, D)
     principal64 = principal_strain_func(D, dim)
     hencky64 = hencky_strain_func(D)
+    cauchy_of = cauchy_from_principal_func(T, dim)
     p0f = camclay_p0_func(T)
     bp0f = bonded_p0_func(T)
     plastic = model != "elastic"
@@ -71,16 +72,7 @@ def drive_kernel(dim, T, model):
         U, eps, Vm, s, svd = principal64(MD(H), D(hzz), D(m.s_floor))
         tau = hencky64(eps, D(m.mu), D(m.lam))
         J = wp.exp(eps[0] + eps[1] + eps[2] + D(lj) - D(m.log_jp_ref))
-        sig = M3()
-        for a in range(dim):
-            for b in range(dim):
-                acc = D(0.0)
-                for k in range(dim):
-                    acc += U[a, k] * tau[k] * U[b, k]
-                sig[a, b] = T(acc / J)
-        if wp.static(dim == 2):
-            sig[2, 2] = T(tau[2] / J)
-        return sig, V3(eps), V3(tau)
+        return cauchy_of(U, tau, J), V3(eps), V3(tau)
 
     @wp.func
     def p0_of(lj: T, kap: T, m: P):
