@@ -382,3 +382,60 @@ def test_kill_at_each_write(tmp_path, mode):
         for k in range(run.n_frames):
             np.testing.assert_array_equal(run.frame(k)["x"], base + k)
             assert run.times[k] == 0.5 * k and run.wall_forces[k, 0, 0] == k
+
+
+PAGE_CHILD = r"""
+import sys
+import numpy as np
+from mpm_warp.io import RunWriter
+path, n_frames = sys.argv[1], int(sys.argv[2])
+base = np.random.default_rng(1).random((20, 3), dtype=np.float32)
+with RunWriter(path, n_particles=20, particle_fields={"x": ((3,), "float32", "m")}, wall_names=["a", "b"],
+               scalar_series={"kinetic_energy": "J"}) as w:
+    for k in range(n_frames):
+        w.write_frame(0.5 * k, k, {"x": base + k}, np.full((2, 3), float(k)), {"kinetic_energy": k})
+"""
+
+
+def test_series_chunks_fit_one_page(tmp_path):
+    """The small per-frame series are rewritten in place at every frame until their chunk is full: each chunk
+    (rows and Fletcher-32 checksum) must lie inside one 4 KiB page of a paged-aggregation file, so that a
+    SIGKILL during the rewrite (Linux stops a write only between pages) cannot tear it and take every frame
+    of the chunk with it."""
+    path = tmp_path / "run.h5"
+    subprocess.run([sys.executable, "-c", PAGE_CHILD, str(path), "1100"], env=_child_env(), check=True)
+    with h5py.File(path, "r") as f:
+        fcpl = f.id.get_create_plist()
+        assert fcpl.get_file_space_strategy()[0] == h5py.h5f.FSPACE_STRATEGY_PAGE
+        assert fcpl.get_file_space_page_size() == 4096
+        for name, row in (("time", 8), ("step", 8), ("scalars/kinetic_energy", 8), ("walls/forces", 48)):
+            d = f[name]
+            assert d.shape[0] == 1100 and d.chunks[0] == (4096 - 4) // row, name
+            n_chunks = d.id.get_num_chunks()
+            assert n_chunks == -(-1100 // d.chunks[0]), name
+            for i in range(n_chunks):
+                info = d.id.get_chunk_info(i)
+                assert info.size <= 4096 and info.byte_offset // 4096 == (info.byte_offset + info.size - 1) // 4096, \
+                    (name, i, info.byte_offset, info.size)
+        np.testing.assert_array_equal(f["walls/forces"][:, 1, 2], np.arange(1100.0))
+        np.testing.assert_array_equal(f["time"][()], 0.5 * np.arange(1100))
+
+
+@pytest.mark.skipif(not _strace_works(), reason="needs strace (and ptrace) to record the writes")
+def test_no_write_in_place_straddles_a_page(tmp_path):
+    """Every pwrite of a 1100-frame run that rewrites bytes written before (chunk index, headers, the series'
+    partly filled chunks) stays inside one 4 KiB page; only new, not yet referenced chunks span pages."""
+    path, log = tmp_path / "run.h5", tmp_path / "pwrite.log"
+    subprocess.run(["strace", "-qq", "-o", str(log), "-e", "trace=pwrite64", sys.executable, "-c", PAGE_CHILD,
+                    str(path), "1100"], env=_child_env(), check=True)
+    written, straddling, n = set(), [], 0
+    for line in log.read_text().splitlines():
+        parts = line.rsplit(")", 1)[0].rsplit(",", 2)
+        if not line.startswith("pwrite64(") or len(parts) < 3:
+            continue
+        size, offset = int(parts[1]), int(parts[2])
+        n += 1
+        if offset in written and offset // 4096 != (offset + size - 1) // 4096:
+            straddling.append((offset, size))
+        written.add(offset)
+    assert n > 1100 * 4 and not straddling, (n, straddling[:5])

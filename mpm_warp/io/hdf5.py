@@ -12,14 +12,22 @@ from ..errors import InvalidArgument, OutputError
 from .opening import DamagedFile, open_read
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "now", "to_json", "set_attrs", "get_attrs", "open_read",
-           "check_format", "series_datasets", "layout", "check_name", "LIBVER", "SERIES_CHUNK",
+           "check_format", "series_datasets", "layout", "check_name", "LIBVER", "PAGE", "series_chunk",
            "RESERVED_ATTRS", "COMPRESSION"]
 
 FORMAT = "mpm_warp-run"
 FORMAT_VERSION = 1
 CHECKPOINT_FORMAT = "mpm_warp-checkpoint"
 LIBVER = ("v110", "v110")
-SERIES_CHUNK = 256                       # frames per chunk of the small per-frame series
+#: file-space page [bytes] of run files (HDF5 paged aggregation), the Linux page: an object smaller than a page
+#: never straddles two, so rewriting it in place is one page-cache copy, which a SIGKILL cannot tear
+PAGE = 4096
+
+
+def series_chunk(row_bytes: int) -> int:
+    """Frames per chunk of a small per-frame series: the most whose chunk, with its 4-byte Fletcher-32
+    checksum, fits in one :data:`PAGE` (a chunk is rewritten in place at every frame until it is full)."""
+    return max(1, (PAGE - 4) // max(1, int(row_bytes)))
 RESERVED_ATTRS = {"format", "format_version", "created", "n_particles", "json_attrs"}
 COMPRESSION = {"gzip": dict(compression="gzip", compression_opts=1, shuffle=True),
                 "lzf": dict(compression="lzf", shuffle=True), "none": {}}
