@@ -101,7 +101,7 @@ import math
 
 import warp as wp
 
-from .camclay import SINGULAR_VALUE_FLOOR, _ellipse_closest_func, camclay_p0_func, camclay_yield_func
+from .camclay import SINGULAR_VALUE_FLOOR, camclay_p0_func, camclay_yield_func, ellipse_point_func
 from .types import vec3
 
 __all__ = [
@@ -188,7 +188,7 @@ def _project_func(T):
     coordinates and tip handling as ``camclay_return``: ``u = (p - pc)/a``,
     ``v = q/(a rho)``, ellipse ``u^2 + v^2/c^2 = 1``, ``c = M/(rho sqrt(1 + 2 beta_e))``.
     """
-    closest = _ellipse_closest_func(T)
+    ellipse_point = ellipse_point_func(T)
     yield_fn = camclay_yield_func(T)
 
     @wp.func
@@ -198,24 +198,7 @@ def _project_func(T):
         a = T(0.5) * p0 * (T(1.0) + beta_e)
         if a <= T(0.0):
             return T(0.0), T(0.0), T(0.0)
-        pc = T(0.5) * p0 * (T(1.0) - beta_e)
-        rho = wp.sqrt(T(3.0) * mu / K)
-        c = M / (wp.sqrt(T(1.0) + T(2.0) * beta_e) * rho)
-        du = p_tr - pc
-        u = wp.abs(du) / a
-        v = q_tr / (a * rho)
-        xu = T(0.0)
-        xv = T(0.0)
-        if c <= T(1.0):
-            xu, xv = closest(T(1.0), c, u, v)
-        else:
-            xv, xu = closest(c, T(1.0), v, u)
-        sgn = T(1.0)
-        p = p0 - a * (T(1.0) - xu)
-        if du < T(0.0):
-            sgn = T(-1.0)
-            p = -beta_e * p0 + a * (T(1.0) - xu)
-        q = a * rho * xv
+        p, q, xu, xv, c, rho, a, sgn = ellipse_point(p_tr, q_tr, p0, K, mu, M, beta_e)
         # homothety derivative in the Euclidean coordinates (P, Q) = (p, q/rho):
         # normal ~ (sgn xu, xv/c^2), tangent t ~ (-xv/c^2, sgn xu), curvature 1/(a c^2 (xu^2 + xv^2/c^4)^(3/2))
         n2 = xv / (c * c)

@@ -34,6 +34,7 @@ __all__ = [
     "camclay_p0_func",
     "camclay_pq_func",
     "camclay_project_func",
+    "ellipse_point_func",
     "camclay_return_func",
     "camclay_return_strain_func",
     "camclay_yield_func",
@@ -289,38 +290,60 @@ def camclay_return_func(T):
 
 
 @functools.cache
+def ellipse_point_func(T):
+    """Build ``ellipse_point(p_tr, q_tr, p0, K, mu, M, beta) -> (p, q, xu, xv, c, rho, a, sgn)``.
+
+    The point ``(p, q)`` (Pa) of the yield ellipse of ``p0`` closest to ``(p_tr, q_tr)`` in the energy
+    metric ``dp^2/K + dq^2/(3 mu)``, for ``a = p0 (1 + beta)/2 > 0`` (the caller's check), with the scaled
+    coordinates it was found in: ``(xu, xv)`` on the unit-``u`` ellipse ``u^2 + v^2/c^2 = 1``
+    (``u = |p - pc|/a``, ``v = q/(a rho)``, ``rho = sqrt(3 mu/K)``, ``c = M/(rho sqrt(1 + 2 beta))``) and
+    ``sgn`` = -1 when the point is measured from the tensile tip (``p_tr < pc``), +1 else. The one
+    projection of :func:`camclay_project_func` and of the bonded return (which needs the scaled point for
+    its homothety derivative).
+    """
+    closest = _ellipse_closest_func(T)
+
+    @wp.func
+    def ellipse_point(p_tr: T, q_tr: T, p0: T, K: T, mu: T, M: T, beta: T):
+        a = T(0.5) * p0 * (T(1.0) + beta)
+        pc = T(0.5) * p0 * (T(1.0) - beta)
+        rho = wp.sqrt(T(3.0) * mu / K)  # q = a rho v
+        c = M / (wp.sqrt(T(1.0) + T(2.0) * beta) * rho)
+        du = p_tr - pc
+        u = wp.abs(du) / a
+        v = q_tr / (a * rho)
+        xu = T(0.0)
+        xv = T(0.0)
+        if c <= T(1.0):
+            xu, xv = closest(T(1.0), c, u, v)
+        else:
+            xv, xu = closest(c, T(1.0), v, u)
+        p = p0 - a * (T(1.0) - xu)
+        sgn = T(1.0)
+        if du < T(0.0):  # measured from the nearer tip: exact there, even for beta >> 1
+            p = -beta * p0 + a * (T(1.0) - xu)
+            sgn = T(-1.0)
+        return p, a * rho * xv, xu, xv, c, rho, a, sgn
+
+    return ellipse_point
+
+
+@functools.cache
 def camclay_project_func(T):
     """Build ``camclay_project(p_tr, q_tr, p0, K, mu, M, beta) -> (p_new, q_new)`` (Pa).
 
     The point of the yield ellipse of ``p0`` closest to a trial ``(p_tr, q_tr)``
     outside it, in the energy metric ``dp^2/K + dq^2/(3 mu)`` (the projection of
-    :func:`camclay_return_func`, which see): stress-free for ``p0 <= 0``.
+    :func:`camclay_return_func`, which see; :func:`ellipse_point_func`): stress-free for ``p0 <= 0``.
     """
-    closest = _ellipse_closest_func(T)
+    ellipse_point = ellipse_point_func(T)
 
     @wp.func
     def camclay_project(p_tr: T, q_tr: T, p0: T, K: T, mu: T, M: T, beta: T):
         p_new = T(0.0)
         q_new = T(0.0)
-        a = T(0.5) * p0 * (T(1.0) + beta)
-        if a > T(0.0):
-            pc = T(0.5) * p0 * (T(1.0) - beta)
-            rho = wp.sqrt(T(3.0) * mu / K)  # q = a rho v
-            c = M / (wp.sqrt(T(1.0) + T(2.0) * beta) * rho)
-            du = p_tr - pc
-            u = wp.abs(du) / a
-            v = q_tr / (a * rho)
-            xu = T(0.0)
-            xv = T(0.0)
-            if c <= T(1.0):
-                xu, xv = closest(T(1.0), c, u, v)
-            else:
-                xv, xu = closest(c, T(1.0), v, u)
-            if du < T(0.0):  # measured from the nearer tip: exact there, even for beta >> 1
-                p_new = -beta * p0 + a * (T(1.0) - xu)
-            else:
-                p_new = p0 - a * (T(1.0) - xu)
-            q_new = a * rho * xv
+        if T(0.5) * p0 * (T(1.0) + beta) > T(0.0):
+            p_new, q_new, xu, xv, c, rho, a, sgn = ellipse_point(p_tr, q_tr, p0, K, mu, M, beta)
         return p_new, q_new
 
     return camclay_project
