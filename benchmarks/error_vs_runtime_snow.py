@@ -74,14 +74,16 @@ def pst_level(dx: float, precision: str, bracket: dict, device: str) -> dict:
                        log=lambda s: print(f"  pst dx {dx}: {s}", flush=True))
     wall = time.perf_counter() - t0
     b = res.base
+    steps = int(sum(t["steps"] for t in res.trials))          # the base run's and every trial's own
     n_particles = estimate_memory(sc, device).n_particles
     return {"dx": dx, "cells_across_layer": sc.scene.weak_layer_thickness / dx, "precision": precision,
             "critical_cut": res.value if res.bracketed else math.nan, "critical_cut_bracket": [res.lo, res.hi],
             "bracketed": res.bracketed, "note": res.note, "trials": res.trials,
             "speed": b.get("damage_speed_mean"), "speed_over": b.get("damage_speed_mean_over"),
             "touchdown": b.get("touchdown"), "collapse_height": b.get("collapse_height"),
-            "wall_time_s": wall, "n_particles": n_particles,
-            "simulated_s": float(sum(t["t_end"] for t in res.trials)),
+            "wall_time_s": wall, "n_particles": n_particles, "steps": steps,
+            "particle_steps_per_s": n_particles * steps / wall,
+            "simulated_s": float(sum(t["t_end"] - t["t_start"] for t in res.trials)),
             "bisection": bracket}
 
 
@@ -227,6 +229,7 @@ def main(argv=None) -> int:
             else:
                 rec = shear_level(SHEAR_CELLS[i], prec, a.device)
             rec["level"], rec["device"] = i, a.device     # a level run on a GPU is not a CPU wall time
+            rec["git_commit"] = environment(a.device).get("git_commit")   # levels may come from different runs
             data = load(a.results)     # merged into what is there now: another process may have written levels
             data["environment"] = environment(a.device)
             have = data["ladders"].setdefault(ladder, [])

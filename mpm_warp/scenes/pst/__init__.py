@@ -46,12 +46,12 @@ from ..references import critical_cut_length_formula, heierli_speed, heierli_tou
 from ..snow import SETTLE_TIME_KEYS
 from .analysis import pst_summary
 from .build import build
-from .critical import CriticalCut, critical_cut
+from .critical import CriticalCut, critical_cut, cut_run
 from .monitor import PSTMonitor, attach
 from .params import Front, PSTParams, Saw
 
 __all__ = ["SCENE", "PSTParams", "Saw", "Front", "build", "attach", "PSTMonitor", "pst_summary", "critical_cut",
-           "CriticalCut", "heierli_speed", "heierli_touchdown", "critical_cut_length_formula"]
+           "cut_run", "CriticalCut", "heierli_speed", "heierli_touchdown", "critical_cut_length_formula"]
 
 SCENE = SceneType(
     kind="pst", params=PSTParams, build=build, attach=attach, time_keys=SETTLE_TIME_KEYS,

@@ -25,7 +25,7 @@ from .analysis import end_zone
 from .monitor import PSTMonitor, attach
 from .params import PSTParams
 
-__all__ = ["CriticalCut", "critical_cut"]
+__all__ = ["CriticalCut", "critical_cut", "cut_run"]
 
 
 @dataclasses.dataclass
@@ -40,7 +40,8 @@ class CriticalCut:
         The longest cut that arrested and the shortest that propagated (m).
     trials : list of dict
         ``cut`` (m), ``propagated``, ``front`` (m: the damage front's reach when the trial ended),
-        ``t_end`` (s: simulated time the trial ended), ``wall`` (s).
+        ``t_start``, ``t_end`` (s: simulated times the trial started from its snapshot and ended; the
+        base run starts at 0), ``steps`` (the trial's own), ``wall`` (s).
     runaway_cut : float
         The base run's one-run estimate (m; nan if its crack never ran away from the saw).
     base : dict
@@ -138,7 +139,7 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
     base = _trial(sim, mon, hi, run_distance if base_run_distance is None else base_run_distance,
                   free_run if base_free_run is None else base_free_run, check_interval)
     base_summary = mon.result()
-    trials = [{**base, "wall": _time.perf_counter() - wall0}]
+    trials = [{**base, "t_start": 0.0, "steps": sim.stepper.clock()[2], "wall": _time.perf_counter() - wall0}]
     if log:
         log(f"cut {hi:.4g} m (base): propagated={base['propagated']}, front {base['front']:.3f} m")
     cache = {hi: base["propagated"]}
@@ -150,8 +151,9 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         k = max(i for i, (pos, _) in enumerate(snaps) if pos <= cut + 1e-12)
         tsim, tmon = _simulation(_with_cut(scenario, cut), device, n_threads)
         tsim.load_snapshot(*snaps[k][1])
+        steps0, t_start = tsim.stepper.clock()[2], tsim.time
         out = _trial(tsim, tmon, cut, run_distance, free_run, check_interval)
-        out["wall"] = _time.perf_counter() - t0
+        out.update(t_start=t_start, steps=tsim.stepper.clock()[2] - steps0, wall=_time.perf_counter() - t0)
         trials.append(out)
         cache[cut] = out["propagated"]
         if log:
@@ -167,6 +169,28 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
                            bracketed=False, note=why)
     b = bisect_threshold(propagates, lo, hi, tol, check_ends=False)
     return CriticalCut(b.value, b.lo, b.hi, trials, runaway, base_summary, _time.perf_counter() - wall0)
+
+
+def cut_run(scenario, cut: float, run_distance: float, free_run: float, check_interval: float = 0.01,
+            device: str | None = None, n_threads: int | None = None) -> dict:
+    """One PST run with its saw stopped at ``cut`` (m): the base run of :func:`critical_cut` without its snapshots.
+
+    Settles, saws to ``cut`` with a frame of the monitor's series every ``check_interval`` (s), then
+    runs until the damage front is ``run_distance`` (m) beyond the cut (or in the end zone) or
+    ``free_run`` (s) has passed since the saw stopped. Returns the trial record (``cut``, ``propagated``,
+    ``front``, ``t_end``, ``steps``) with the run's :func:`~.analysis.pst_summary` under ``"summary"`` (front speed,
+    touchdown, collapse height).
+    """
+    p = scenario.scene
+    if not isinstance(p, PSTParams):
+        raise TypeError("cut_run needs a PST scenario (scene kind 'pst')")
+    if not 0.0 < cut <= p.length:
+        raise ValueError(f"cut = {cut} m: need 0 < cut <= length = {p.length} m")
+    sim, mon = _simulation(_with_cut(scenario, cut), device, n_threads)
+    sim.step_to(p.saw_start)
+    _step_recording(sim, mon, p.saw_start + cut / p.saw.speed, check_interval)
+    out = _trial(sim, mon, cut, run_distance, free_run, check_interval)
+    return {**out, "steps": sim.stepper.clock()[2], "summary": mon.result()}
 
 
 def _step_recording(sim: Simulation, mon: PSTMonitor, t_end: float, check_interval: float) -> None:
