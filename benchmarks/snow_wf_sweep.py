@@ -25,7 +25,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from common import RESULTS, environment, write_json  # noqa: E402
+from common import RESULTS, dask_map, environment, write_json  # noqa: E402
 
 #: the ladder PST (benchmarks/error_vs_runtime_snow.py) at dx 10 mm, 6 cells across its 6 cm layer
 COLUMN = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
@@ -101,18 +101,9 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--device", default="cpu")
     a = ap.parse_args(argv)
-    from dask.distributed import Client, LocalCluster
-
     values = [float(v) for v in a.w_f.split(",")]
     t0 = time.perf_counter()
-    os.environ["MPM_WARP_THREADS"] = "1"
-    cluster = None if a.scheduler else LocalCluster(n_workers=min(a.workers, len(values)), threads_per_worker=1,
-                                                     dashboard_address=None)
-    with Client(a.scheduler or cluster) as client:
-        futures = [client.submit(one_case, w, a.lo, a.hi, a.tol, a.device, pure=False) for w in values]
-        rows = client.gather(futures)
-    if cluster is not None:
-        cluster.close()
+    rows = dask_map(one_case, [(w, a.lo, a.hi, a.tol, a.device) for w in values], a.workers, a.scheduler)
     rows.sort(key=lambda r: r["w_f"])
     data = {"cases": rows, "column": COLUMN, "bracket": [a.lo, a.hi, a.tol], "wall_s": time.perf_counter() - t0,
             "environment": environment(a.device)}

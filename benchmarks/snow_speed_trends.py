@@ -1,0 +1,146 @@
+"""Crack speed against slab stiffness and collapse height (VALIDATION.md, Snow: "speed grows with slab
+stiffness, falls with collapse height").
+
+On the PST of the error-against-run-time ladder at its 6-cell level (2.2 m column, 0.3 m slab, 6 cm
+weak layer, dx 10 mm; everything else ``pst_flat``), one parameter is changed at a time around the
+centre case:
+
+- the slab's Young's modulus ``E``: 2.5, 5 (centre), 10 MPa (density fixed);
+- the weak layer's collapse height ``h_c`` (a field quantity of the calibration,
+  :mod:`mpm_warp.scenes.weak_layer.calibration`): 0.5, 1 (centre: the WEAC fit, 4.7 mm for 6 cm),
+  2 times the fit.
+
+Each case is one run (:func:`mpm_warp.scenes.pst.cut_run`): the saw stops at 0.7 m, beyond every
+case's critical cut, and the crack runs into the far end zone; its speed is the damage front's mean
+from the cut to the end zone (1.9 m). Beside it, Heierli's (2005) speed of an elastic slab on a
+collapsing layer with the run's own measured collapse height, ``c ~ E^(1/4) h_f^(-1/4)``. The
+log-log slopes ``d ln c / d ln E`` and ``d ln c / d ln h_f`` (the measured collapse on the axis) are
+reported against Heierli's +1/4 and -1/4.
+
+Cases run as Dask tasks (:func:`common.dask_map`, one worker process per core). Writes
+``benchmarks/results/snow_speed_trends.json`` and ``.png``.
+
+Usage::
+
+    nohup .venv/bin/python benchmarks/snow_speed_trends.py > trends.log 2>&1 &
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from common import RESULTS, dask_map, environment, write_json  # noqa: E402
+from snow_wf_sweep import COLUMN, FIELD_SPEED  # noqa: E402
+
+CUT = 0.7                                   # m: the saw's stop, beyond every case's critical cut
+SLAB_E = (2.5e6, 5.0e6, 1.0e7)              # Pa
+H_C_FACTORS = (0.5, 1.0, 2.0)               # of the WEAC fit of the layer's thickness
+
+
+def one_case(param: str, value: float, device: str) -> dict:
+    """One PST with ``param`` (``"slab.E"`` or ``"weak_layer.h_c"``) set to ``value``: runs in a Dask worker."""
+    import mpm_warp as mw
+    from mpm_warp.scenes.pst import cut_run
+
+    sc = mw.load_scenario("pst_flat", COLUMN + [f"scene.{param}={value!r}"])
+    t0 = time.perf_counter()
+    r = cut_run(sc, CUT, run_distance=sc.scene.length, free_run=0.5, device=device, n_threads=1)
+    s = r["summary"]
+    return {"param": param, "value": value, "propagated": r["propagated"], "front": r["front"],
+            "speed": s.get("damage_speed_mean"), "speed_over": s.get("damage_speed_mean_over"),
+            "collapse_height": s.get("collapse_height"), "touchdown": s.get("touchdown"),
+            "heierli_speed_run": s.get("heierli_speed_run"), "h_c_calibrated": sc.scene.calibrated().h_c,
+            "slab_E": sc.scene.slab.E, "steps": r["steps"], "wall_s": time.perf_counter() - t0}
+
+
+def slope(x, y) -> float:
+    """Least-squares slope of ``ln y`` against ``ln x`` (nan if fewer than two finite points)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+    return float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0]) if ok.sum() >= 2 else math.nan
+
+
+def figure(data: dict, path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for ax, (key, xlabel, xscale, x_of) in zip(axes, (
+            ("slab.E", "slab Young's modulus E [MPa]", 1e-6, lambda r: r["value"]),
+            ("weak_layer.h_c", "measured collapse height h_f [mm]", 1e3, lambda r: r["collapse_height"])),
+            strict=True):
+        rows = data["trends"][key]["cases"]
+        x = np.array([x_of(r) for r in rows]) * xscale
+        ax.plot(x, [r["speed"] for r in rows], "o-", color="C3",
+                label=f"damage front, mean {CUT:g}-{rows[0]['speed_over'][1]:.1f} m "
+                      f"(slope {data['trends'][key]['slope_speed']:+.2f})")
+        ax.plot(x, [r["heierli_speed_run"] for r in rows], "s--", color="C2",
+                label=f"Heierli, run's collapse (slope {data['trends'][key]['slope_heierli']:+.2f})")
+        ax.axhspan(*FIELD_SPEED, color="0.88", label="field 20-30 m/s")
+        ax.set(xscale="log", yscale="log", xlabel=xlabel, ylabel="crack speed [m/s]")
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+            axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xticks(x)
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%.3g"))
+        lo, hi = ax.get_ylim()
+        ax.set_yticks([v for v in (5, 10, 15, 20, 25, 30, 40, 50, 60, 80, 100, 150) if lo <= v <= hi])
+        ax.legend(fontsize=8)
+    axes[0].set_title("speed against slab stiffness (h_c: WEAC fit)", fontsize=9)
+    axes[1].set_title("speed against collapse height (h_c x 0.5, 1, 2; E = 5 MPa)", fontsize=9)
+    fig.suptitle("PST (2.2 m column, 0.3 m slab, 6 cm layer at 6 cells, cut 0.7 m): one parameter at a time",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--device", default="cpu")
+    a = ap.parse_args(argv)
+    from mpm_warp.scenes.references import weac_collapse_height
+
+    h_fit = weac_collapse_height(0.06)
+    cases = [("slab.E", e) for e in SLAB_E] + [("weak_layer.h_c", f * h_fit) for f in H_C_FACTORS if f != 1.0]
+    t0 = time.perf_counter()
+    rows = dask_map(one_case, [(p, v, a.device) for p, v in cases], a.workers, a.scheduler)
+    centre = next(r for r in rows if r["param"] == "slab.E" and r["value"] == 5.0e6)
+    trends = {}
+    for key, members in (("slab.E", [r for r in rows if r["param"] == "slab.E"]),
+                         ("weak_layer.h_c", sorted([r for r in rows if r["param"] == "weak_layer.h_c"] + [centre],
+                                                   key=lambda r: r["collapse_height"]))):
+        x = [r["value"] if key == "slab.E" else r["collapse_height"] for r in members]
+        trends[key] = {"cases": members, "slope_speed": slope(x, [r["speed"] for r in members]),
+                       "slope_heierli": slope(x, [r["heierli_speed_run"] for r in members]),
+                       "heierli_exponent": 0.25 if key == "slab.E" else -0.25,
+                       "monotone": bool(np.all(np.diff([r["speed"] for r in members]) *
+                                               (1 if key == "slab.E" else -1) > 0))}
+    data = {"trends": trends, "column": COLUMN, "cut": CUT, "h_c_fit": h_fit, "wall_s": time.perf_counter() - t0,
+            "environment": environment(a.device)}
+    write_json("snow_speed_trends", data)
+    figure(data, os.path.join(RESULTS, "snow_speed_trends.png"))
+    for key, t in trends.items():
+        print(f"{key}: speed slope {t['slope_speed']:+.3f} (Heierli with the runs' collapse {t['slope_heierli']:+.3f},"
+              f" closed form {t['heierli_exponent']:+.2f}); monotone {t['monotone']}")
+        for r in t["cases"]:
+            print(f"  {r['param']} = {r['value']:.4g}: speed {r['speed']:.3g} m/s, "
+                  f"collapse {r['collapse_height']:.4g} m, touchdown {r['touchdown']:.3g} m, "
+                  f"Heierli {r['heierli_speed_run']:.3g} m/s, {r['wall_s']:.0f} s")
+    return 0 if all(t["monotone"] for t in trends.values()) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
