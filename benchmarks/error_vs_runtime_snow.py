@@ -28,6 +28,8 @@ Usage (hours on 2 CPU cores; the finest PST level dominates)::
     nohup .venv/bin/python benchmarks/error_vs_runtime_snow.py > ladder.log 2>&1 &
     .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder shear --levels 0 1   # the two coarsest
     .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --device cuda:0   # on a GPU
+    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --base-only \
+        --workdir runs/   # the 24-cell base run on the CPU, over several sessions (rerun to resume)
 
 A level run on a GPU records its device and serves as a reference; the wall times to 5 % and 1 % are
 this CPU's only.
@@ -87,6 +89,72 @@ def pst_level(dx: float, precision: str, bracket: dict, device: str) -> dict:
             "bisection": bracket}
 
 
+def pst_base_level(dx: float, precision: str, device: str, workdir: str) -> dict | None:
+    """One PST level's base run alone (speed, touchdown, collapse height; no critical cut), resumable.
+
+    The run the critical-cut search starts with (cut at the bracket's top, frames every 0.01 s, stopped
+    once the damage front is in the far end zone or 0.5 s after the saw stopped), as a run file with a
+    checkpoint every frame in ``workdir``: a call after a kill, or in a later session, resumes it
+    (:func:`mpm_warp.resume`). For a level that takes hours on this CPU (the 24-cell PST: about 8 h).
+    Returns the level's record once the run is done, None when it stopped early (the sessions' wall
+    times and steps add up in ``<run>.sessions.json``).
+    """
+    from mpm_warp.scenes.pst.analysis import end_zone
+
+    cut = PST_BRACKET["hi"]
+    sc = mw.load_scenario("pst_flat", PST_SCENE + [f"scene.dx={dx!r}", f'precision="{precision}"',
+                                                   f"scene.saw.cut_length={cut!r}", "output.checkpoint_every=1",
+                                                   "time.frame_interval=0.01"])
+    p = sc.scene
+    goal = p.length - end_zone(p)                 # base_run_distance = length: into the end zone
+    t_stop = p.saw_start + cut / p.saw.speed + 0.5
+    os.makedirs(workdir, exist_ok=True)
+    path = os.path.join(workdir, f"pst_dx{dx:g}_{precision}.h5")
+    log_path = path[:-3] + ".sessions.json"
+    sessions = json.load(open(log_path)) if os.path.isfile(log_path) else []
+    # a session's record is rewritten at every frame (after its checkpoint): a killed session keeps the wall
+    # time and steps up to its last checkpoint, and the work it lost after that is redone and counted once
+    now = {}
+
+    def started(sim):
+        now.update(t0=time.perf_counter(), steps_from=sim.stepper.clock()[2])
+        sessions.append({"wall_time_s": 0.0, "steps": 0, "t_end": sim.time, "done": False})
+
+    def running(sim, frame):                      # False stops the run: the front reached the end zone
+        front_in = sim.monitors["pst"].damage_front(sim.time) >= goal
+        sessions[-1].update(wall_time_s=time.perf_counter() - now["t0"], t_end=sim.time,
+                            steps=sim.stepper.clock()[2] - now["steps_from"],
+                            done=bool(front_in or sim.time >= t_stop - 1e-9))
+        if sessions[-1]["done"]:
+            sessions[-1]["result"] = {k: v for k, v in sim.monitors["pst"].result().items()
+                                      if k in ("damage_speed_mean", "damage_speed_mean_over", "touchdown",
+                                               "collapse_height")}
+        with open(log_path + ".tmp", "w") as fh:
+            json.dump(sessions, fh, indent=1)
+        os.replace(log_path + ".tmp", log_path)
+        return not front_in
+
+    if not (sessions and sessions[-1]["done"]):
+        if os.path.isfile(path):
+            mw.resume(path, device=device, end_time=t_stop, callback=running, on_start=started)
+        else:
+            mw.run(sc, output=path, device=device, end_time=t_stop, callback=running, on_start=started)
+    last = sessions[-1]
+    if not last["done"]:
+        return None
+    r = last["result"]
+    wall = sum(x["wall_time_s"] for x in sessions)
+    steps = sum(x["steps"] for x in sessions)
+    n_particles = estimate_memory(sc, device).n_particles
+    return {"dx": dx, "cells_across_layer": p.weak_layer_thickness / dx, "precision": precision,
+            "critical_cut": math.nan, "critical_cut_bracket": [math.nan, math.nan], "bracketed": False,
+            "note": "base run only (critical cut not bisected)", "trials": [],
+            "speed": r["damage_speed_mean"], "speed_over": r["damage_speed_mean_over"], "touchdown": r["touchdown"],
+            "collapse_height": r["collapse_height"], "wall_time_s": wall, "n_particles": n_particles,
+            "steps": steps, "particle_steps_per_s": n_particles * steps / wall, "simulated_s": last["t_end"],
+            "sessions": len(sessions), "run_file": path}
+
+
 def shear_level(cells: int, precision: str, device: str) -> dict:
     """One shear-test level: peak, softening slip, collapse."""
     sc = mw.load_scenario("shear_test")
@@ -139,13 +207,17 @@ def summarise(ladder: str, levels: list[dict]) -> dict:
     h = [lv["dx"] for lv in levels]
     for q in QUANTITIES[ladder]:
         v = np.array([lv[q] if lv[q] is not None else math.nan for lv in levels], float)
+        # the reference is the finest level that has the quantity (a base-run-only level has no critical cut)
+        finite = np.flatnonzero(np.isfinite(v))
+        if len(finite):
+            v = v[:finite[-1] + 1]
         ref = v[-1]
         err = np.abs(v / ref - 1.0) if np.isfinite(ref) and ref != 0 else np.full(len(v), math.nan)
-        rich, p = richardson(h, v)
+        rich, p = richardson(h[:len(v)], v)
         err_r = np.abs(v / rich - 1.0) if np.isfinite(rich) else np.full(len(v), math.nan)
         out[q] = {"values": v.tolist(), "error_vs_finest": err.tolist(), "richardson": rich, "observed_order": p,
-                  "error_vs_richardson": err_r.tolist(),
-                  "time_to": {f"{int(100 * t)}%": time_to(list(err_r if np.isfinite(rich) else err), walls, t)
+                  "error_vs_richardson": err_r.tolist(), "reference_level": len(v) - 1,
+                  "time_to": {f"{int(100 * t)}%": time_to(list(err_r if np.isfinite(rich) else err), walls[:len(v)], t)
                               for t in TARGETS},
                   "reference_used_for_time_to": "richardson" if np.isfinite(rich) else "finest level"}
     return out
@@ -206,6 +278,10 @@ def main(argv=None) -> int:
     ap.add_argument("--redo", action="store_true", help="run levels the JSON already has")
     ap.add_argument("--device", default="cpu")
     ap.add_argument("--results", default=RESULTS, help="folder of the JSON and the figure")
+    ap.add_argument("--base-only", action="store_true",
+                    help="PST: the base run alone (no critical cut), checkpointed in --workdir and resumed by the "
+                         "same command after a kill (for the 24-cell level: about 8 h on a 2-core CPU)")
+    ap.add_argument("--workdir", default="error_vs_runtime_snow_runs", help="run files of --base-only")
     a = ap.parse_args(argv)
     data = load(a.results)
     data["environment"] = environment(a.device)
@@ -222,7 +298,12 @@ def main(argv=None) -> int:
             if done and not a.redo:
                 continue
             print(f"{ladder} level {i} ({prec})", flush=True)
-            if ladder == "pst":
+            if ladder == "pst" and a.base_only:
+                rec = pst_base_level(PST_DX[i], prec, a.device, a.workdir)
+                if rec is None:
+                    print(f"pst level {i}: stopped before its end; the same command resumes it", flush=True)
+                    continue
+            elif ladder == "pst":
                 # one bracket for every level: the base run saws to its top, so the speed is measured over
                 # the same distance at every level
                 rec = pst_level(PST_DX[i], prec, dict(PST_BRACKET), a.device)
