@@ -43,7 +43,8 @@ def energy_kernel(dim, T):
         i = wp.tid()
         h = D(0.0)
         if wp.static(dim == 2):
-            h = D(hzz[i])
+            if hzz.shape[0] > 0:  # a plastic group's F_E,zz - 1 (elastic: 0, not stored)
+                h = D(hzz[i])
         U, eps, Vm, s, svd = principal_strain(MD(H[i]), h, D(m.s_floor))
         psi = psi_fn(eps, D(m.mu), D(m.lam))
         vi = v[i]
@@ -79,7 +80,8 @@ def stress_kernel(dim, T):
         i = wp.tid()
         h = D(0.0)
         if wp.static(dim == 2):
-            h = D(hzz[i])
+            if hzz.shape[0] > 0:  # a plastic group's F_E,zz - 1 (elastic: 0, not stored)
+                h = D(hzz[i])
         sf = D(m.s_floor)
         U, eps, Vm, s, svd = principal_strain(MD(H[i]), h, sf)
         tau = hencky(eps, D(m.mu), D(m.lam))
@@ -112,13 +114,11 @@ def health_kernel(dim, T):
     M = mat(dim, T)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def health(x: wp.array(dtype=V), v: wp.array(dtype=V), H: wp.array(dtype=M), hzz: wp.array(dtype=T),
+    def health(x: wp.array(dtype=V), v: wp.array(dtype=V), H: wp.array(dtype=M),
                clock: wp.array(dtype=wp.float64), dx: T, max_cells: T, bad: wp.array(dtype=wp.int32)):
         i = wp.tid()
         vi = v[i]
         finite = wp.isfinite(x[i]) and wp.isfinite(vi) and wp.isfinite(H[i])
-        if wp.static(dim == 2):
-            finite = finite and wp.isfinite(hzz[i])
         if not finite:
             wp.atomic_min(bad, 0, i)
             return
@@ -126,3 +126,17 @@ def health_kernel(dim, T):
             wp.atomic_min(bad, 1, i)
 
     return health
+
+
+@functools.cache
+def health_zz_kernel(T):
+    """Health check of one plastic group's out-of-plane stretches ``hzz`` (plane strain): a non-finite one
+    counts as a non-finite ``F_E`` (``bad[0]``) of particle ``start + i``."""
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def health_zz(hzz: wp.array(dtype=T), start: int, bad: wp.array(dtype=wp.int32)):
+        i = wp.tid()
+        if not wp.isfinite(hzz[i]):
+            wp.atomic_min(bad, 0, start + i)
+
+    return health_zz

@@ -6,6 +6,8 @@ physical order:
 1. trial elastic state ``H_tr = H + L + L H``, ``L = dt C`` (``F_tr = (I + dt C) F_E``,
    MODEL.md 4) and the material's constitutive update, which returns the new
    elastic state and the Kirchhoff stress ``tau`` (``kernels/constitutive.py``);
+   In plane strain a plastic particle also updates its out-of-plane elastic stretch ``hzz``
+   (indexed as ``log_jp``); an elastic one has ``F_E,zz = 1`` and stores none;
 2. scatter of mass and of the MLS-MPM momentum
    ``m v + (m C - dt V0 D^-1 tau) (x_i - x_p)``, ``D^-1 = 4 / dx^2``, to the
    ``3^dim`` nodes of the quadratic B-spline stencil.
@@ -95,9 +97,11 @@ def p2g_kernel(dim, T, model, track_yield):
             lj = log_jp[i]
         if wp.static(bonded):
             kap = kappa[i]
-        if wp.static(dim == 2):
+        if wp.static(dim == 2 and plastic):
             H_new, hzz_new, tau, lj_new, kap_new, flags = update(H_tr, hzz[i], lj, kap, m)
             hzz[i] = hzz_new
+        elif wp.static(dim == 2):  # elastic: F_E,zz is the total, 1 (not stored); the update keeps it
+            H_new, hzz_new, tau, lj_new, kap_new, flags = update(H_tr, T(0.0), lj, kap, m)
         else:
             H_new, tau, lj_new, kap_new, flags = update(H_tr, lj, kap, m)
         H[i] = H_new

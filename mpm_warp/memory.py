@@ -1,17 +1,17 @@
 """Memory a scenario needs, estimated before anything is allocated, and the guard that refuses too much.
 
 Per particle on the device, with ``s`` = 4 bytes (float32) or 8 (float64) and ``d`` the dimension:
-``x``, ``v`` (``d s`` each), ``C``, ``H = F_E - I`` (``d^2 s`` each), in plane strain ``hzz`` (``s``),
-for plastic (Cam-Clay) particles ``log_jp`` (``s``), for bonded ones ``kappa`` (``s``) and, when the
-output asks for it, ``yielded`` (1 byte). A bonded weak layer also has its lattice columns: a column
-index per particle (int32, on the device and on the host) and a float64 pair per column. The grid
-is ``n_copies x nodes x (1 + d)`` scalars (mass and momentum; one copy per CPU thread,
-:func:`mpm_warp.step.grid_copies`). The host keeps the seeded positions and the initial positions
-``x0`` in float64 (``2 d 8`` bytes per particle) and builds the initial ``x``, ``v``, ``C`` before
-uploading them. Frames and checkpoints add host copies of the
-fields they write (not counted). ``tests/test_memory.py`` checks these numbers against what
-:class:`~mpm_warp.model.State`, :class:`~mpm_warp.step.Stepper` and :class:`~mpm_warp.Simulation`
-really allocate.
+``x``, ``v`` (``d s`` each), ``C``, ``H = F_E - I`` (``d^2 s`` each), for plastic (Cam-Clay) particles
+``log_jp`` (``s``) and in plane strain ``hzz`` (``s``; an elastic particle's ``F_E,zz`` is 1, not
+stored), for bonded ones ``kappa`` (``s``) and, when the output asks for it, ``yielded`` (1 byte). A
+bonded weak layer also has its lattice columns: a column index per particle (int32, on the device and on
+the host) and a float64 pair per column. The grid is ``n_copies x nodes x (1 + d)`` scalars (mass and
+momentum; one copy per CPU thread, :func:`mpm_warp.step.grid_copies`). The host keeps the seeded
+positions and the initial positions ``x0`` in float64 (``2 d 8`` bytes per particle) and builds the
+initial ``x``, ``v``, ``C`` before uploading them. Frames and checkpoints add host copies of the fields
+they write (not counted). ``tests/test_memory.py`` checks these numbers against what
+:class:`~mpm_warp.model.State`, :class:`~mpm_warp.step.Stepper` and :class:`~mpm_warp.Simulation` really
+allocate.
 
 The guard (:func:`check_memory`) compares the estimate with the memory available (Linux
 ``MemAvailable``; on CUDA the device's free memory for the device part) and with an optional
@@ -66,9 +66,9 @@ def particle_bytes(dim: int, precision: str, *, plastic: bool = False, bonded: b
                    yielded: bool = False) -> int:
     """Device bytes of one particle (see the module docstring)."""
     s = 8 if precision == "float64" else 4
-    b = (2 * dim + 2 * dim * dim) * s + (s if dim == 2 else 0)
+    b = (2 * dim + 2 * dim * dim) * s
     if plastic:
-        b += s + (s if bonded else 0) + (1 if yielded else 0)
+        b += s + (s if dim == 2 else 0) + (s if bonded else 0) + (1 if yielded else 0)
     return b
 
 

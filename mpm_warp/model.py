@@ -17,6 +17,7 @@ import numpy as np
 import warp as wp
 
 from .config import Scenario
+from .errors import InvalidArgument
 from .kernels.camclay import SINGULAR_VALUE_FLOOR
 from .kernels.constitutive import material_struct
 from .kernels.grid_update import wall_struct
@@ -276,8 +277,9 @@ class State:
         Elastic displacement gradient ``F_E - I`` (-), in-plane block in 2D (see
         ``kernels/constitutive.py``: stored as ``F_E - I`` so that float32 keeps
         increments far below its resolution of 1).
-    hzz : wp.array, (N,) or None
-        Out-of-plane elastic stretch minus one, ``F_E,zz - 1`` (-), plane strain only.
+    hzz : wp.array, (N_plastic,) or None
+        Out-of-plane elastic stretch minus one, ``F_E,zz - 1`` (-), of the plastic particles in plane strain
+        (indexed as ``log_jp``); an elastic particle's ``F_E,zz`` is the total, 1, and is not stored.
     log_jp : wp.array, (N_plastic,) or None
         ln det F_P of Cam-Clay particles.
     kappa : wp.array, (N_bonded,) or None
@@ -304,7 +306,7 @@ class State:
         self.v = wp.array(v.astype(model.np_dtype), dtype=V, device=dev)
         self.C = wp.array(C, dtype=M, device=dev)
         self.H = wp.zeros(n, dtype=M, device=dev)
-        self.hzz = wp.zeros(n, dtype=T, device=dev) if d == 2 else None
+        self.hzz = wp.zeros(model.n_plastic, dtype=T, device=dev) if d == 2 and model.n_plastic else None
         self.log_jp = wp.array(log_jp, dtype=T, device=dev) if model.n_plastic else None
         self.kappa = wp.array(kappa, dtype=T, device=dev) if model.n_bonded else None
         track = track_yield and model.n_plastic > 0
@@ -325,7 +327,10 @@ class State:
         F[:, :d, :d] = H
         F[:, range(3), range(3)] += 1.0
         if self.hzz is not None:
-            F[:, 2, 2] += self.hzz.numpy().astype(np.float64)
+            hzz = self.hzz.numpy().astype(np.float64)
+            for g in self.model.groups:
+                if g.plastic_start >= 0:
+                    F[g.start:g.end, 2, 2] += hzz[g.plastic_start:g.plastic_start + g.count]
         return F
 
     def set_elastic_deformation_gradient(self, F) -> None:
@@ -335,8 +340,18 @@ class State:
         d = self.model.dim
         H = F[:, :d, :d] - np.eye(d)
         self.H.assign(H.astype(self.model.np_dtype))
-        if self.hzz is not None:
-            self.hzz.assign((F[:, 2, 2] - 1.0).astype(self.model.np_dtype))
+        if d == 2:
+            hzz = np.zeros(self.model.n_plastic)
+            for g in self.model.groups:
+                zz = F[g.start:g.end, 2, 2] - 1.0
+                if g.plastic_start >= 0:
+                    hzz[g.plastic_start:g.plastic_start + g.count] = zz
+                elif np.any(zz != 0.0):
+                    raise InvalidArgument(f"F[{g.start}:{g.end}, 2, 2] (group {g.name!r}, elastic, plane strain)",
+                                          float(F[g.start + int(np.argmax(zz != 0.0)), 2, 2]),
+                                          "1 (an elastic particle's out-of-plane stretch is the total one)")
+            if self.hzz is not None:
+                self.hzz.assign(hzz.astype(self.model.np_dtype))
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Host copies of the full state (checkpoints, snapshots): copies, never views of the device
@@ -355,6 +370,8 @@ class State:
             if dst is None or (k == "yielded" and k not in d):   # older checkpoints hold no yielded flags
                 continue
             a = np.asarray(d[k])
+            if k == "hzz" and a.shape[0] != dst.shape[0]:    # an older checkpoint: hzz of every particle
+                a = np.concatenate([a[g.start:g.end] for g in self.model.groups if g.plastic_start >= 0])
             if k == "clock" and a.shape[0] < dst.shape[0]:  # a 3-entry clock of an older checkpoint
                 a = np.concatenate([a, [a[1]]])
             dst.assign(a)

@@ -76,7 +76,7 @@ class GroupState:
     H : wp.array of dim x dim matrices
         Elastic displacement gradient ``F_E - I`` (-) (in 2D the in-plane block).
     hzz : wp.array or None
-        ``F_E,zz - 1`` (-) in plane strain (2D), else None.
+        ``F_E,zz - 1`` (-) of a plastic group in plane strain (2D), else None (an elastic particle's is 0).
     log_jp : wp.array or None
         ``ln det F_P`` of a Cam-Clay group (None for elastic groups).
     kappa : wp.array or None

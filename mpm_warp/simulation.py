@@ -18,7 +18,7 @@ from . import io, snapshot
 from .config import OUTPUT_FIELDS, Scenario
 from .device import resolve_device
 from .errors import InvalidArgument, SimulationBlowUp
-from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, stress_kernel
+from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, health_zz_kernel, stress_kernel
 from .memory import check_memory
 from .model import Model, ParticleGroup, State, material_params
 from .monitor import GroupState, Monitor
@@ -111,9 +111,17 @@ class Simulation:
         g, s = self.group(name), self.state
         sl = slice(g.start, g.end)
         psl = slice(g.plastic_start, g.plastic_start + g.count)
+        plastic = g.plastic_start >= 0
         return GroupState(g.name, g.material, g.start, g.end, g.mass, g.vol0, s.x[sl], s.v[sl], s.C[sl], s.H[sl],
-                          s.hzz[sl] if s.hzz is not None else None, s.log_jp[psl] if g.plastic_start >= 0 else None,
+                          s.hzz[psl] if plastic and s.hzz is not None else None, s.log_jp[psl] if plastic else None,
                           self.x0[sl], s.kappa[psl] if g.columns is not None else None)
+
+    def _hzz_of(self, g) -> wp.array:
+        """``hzz`` of group ``g``'s particles, or an empty array (elastic or 3D: ``F_E,zz`` not stored)."""
+        s = self.state
+        if s.hzz is None or g.plastic_start < 0:
+            return self._no_log_jp
+        return s.hzz[g.plastic_start:g.plastic_start + g.count]
 
     def energies(self) -> dict[str, float]:
         """Kinetic and elastic energy (J; J/m of depth in 2D) of the current state."""
@@ -122,7 +130,7 @@ class Simulation:
         s = self.state
         for g in self.model.groups:
             sl = slice(g.start, g.end)
-            hz = s.hzz[sl] if s.hzz is not None else None
+            hz = self._hzz_of(g)
             wp.launch(energy_kernel(self.model.dim, T), g.count,
                       inputs=[s.v[sl], s.H[sl], hz, T(g.mass), T(g.vol0), material_params(g.material, T),
                               self._energy], device=self.device)
@@ -141,7 +149,7 @@ class Simulation:
         sig = wp.zeros(n, dtype=wp.types.matrix((3, 3), T), device=self.device) if cauchy else None
         for g in self.model.groups:
             sl = slice(g.start, g.end)
-            hz = s.hzz[sl] if s.hzz is not None else None
+            hz = self._hzz_of(g)
             ljp = s.log_jp[g.plastic_start:g.plastic_start + g.count] if g.plastic_start >= 0 else self._no_log_jp
             wp.launch(stress_kernel(self.model.dim, T), g.count,
                       inputs=[s.H[sl], hz, ljp, material_params(g.material, T), int(cauchy), p[sl], q[sl],
@@ -193,8 +201,13 @@ class Simulation:
         s = self.state
         T = self.model.T
         wp.launch(health_kernel(self.model.dim, T), self.model.n_particles,
-                  inputs=[s.x, s.v, s.H, s.hzz, s.clock, T(self.model.dx), T(MAX_CELLS_PER_STEP), self._bad],
+                  inputs=[s.x, s.v, s.H, s.clock, T(self.model.dx), T(MAX_CELLS_PER_STEP), self._bad],
                   device=self.device)
+        if s.hzz is not None:
+            for g in self.model.groups:
+                if g.plastic_start >= 0:
+                    wp.launch(health_zz_kernel(T), g.count, inputs=[self._hzz_of(g), g.start, self._bad],
+                              device=self.device)
         bad = self._bad.numpy()
         causes = [("x/v/F", "non-finite value (NaN or Inf)"),
                   ("v", f"moved more than {MAX_CELLS_PER_STEP:g} cell in one step (|v| dt > dx): "

@@ -128,13 +128,13 @@ class Stepper:
                 if b <= a:
                     continue
                 sl = slice(a, b)
-                ljp, kap, yld = unused[T], unused[T], unused[wp.uint8]
+                ljp, kap, yld, hz = unused[T], unused[T], unused[wp.uint8], unused[T]
                 if plastic:
                     psl = slice(g.plastic_start + a - g.start, g.plastic_start + b - g.start)
                     ljp = s.log_jp[psl]
                     kap = s.kappa[psl] if g.columns is not None else kap
                     yld = s.yielded[psl] if s.yielded is not None else yld
-                hz = s.hzz[sl] if s.hzz is not None else unused[T]
+                    hz = s.hzz[psl] if s.hzz is not None else hz
                 self._p2g[k].append(wp.launch(
                     k_p2g, b - a,
                     inputs=[s.x[sl], s.v[sl], s.C[sl], s.H[sl], hz, ljp, kap, yld, T(g.mass), T(g.vol0), m_par,

@@ -251,3 +251,40 @@ def test_resume_2d_bit_for_bit(tmp_path):
     for k in ("x", "v", "log_jp", "F"):
         np.testing.assert_array_equal(a.field(k), b.field(k))
     assert a.frame(-1)["x"].shape[1] == 2
+
+
+def test_elastic_particles_store_no_out_of_plane_stretch():
+    """Plane strain: an elastic particle's F_E,zz is the total, 1, and is not stored; a plastic one's is (hzz,
+    indexed as log_jp). F_E round-trips through the state, and an elastic F_zz != 1 is refused by name."""
+    sc, _, _ = weak_layer_column(dx=1.0 / 64.0, xi=0.01, rho_slab=2400.0, precision="float64")
+    sim = mw.Simulation(as_plane_strain(sc), device=DEVICE)
+    m = sim.model
+    assert 0 < m.n_plastic < m.n_particles and sim.state.hzz.shape == (m.n_plastic,)
+    assert mw.Simulation(_free_2d((0.1, 0.0)), device=DEVICE).state.hzz is None   # elastic only: none at all
+    sim.step_to(0.05)                                                 # the layer compacts: F_E,zz moves
+    F = sim.state.elastic_deformation_gradient()
+    plastic = np.zeros(m.n_particles, bool)
+    for g in m.groups:
+        plastic[g.start:g.end] = g.plastic_start >= 0
+    assert (F[~plastic, 2, 2] == 1.0).all() and (np.abs(F[plastic, 2, 2] - 1.0) > 1e-6).all()
+    sim.state.set_elastic_deformation_gradient(F)
+    np.testing.assert_array_equal(sim.state.elastic_deformation_gradient(), F)
+    F[np.flatnonzero(~plastic)[3], 2, 2] = 1.01
+    with pytest.raises(mw.InvalidArgument, match=r"F\[.*2, 2\].*elastic, plane strain.*1\.01"):
+        sim.state.set_elastic_deformation_gradient(F)
+
+
+def test_checkpoint_with_hzz_of_every_particle_loads():
+    """A checkpoint of an earlier version holds hzz for every particle (zeros for the elastic ones): it loads."""
+    sc, _, _ = weak_layer_column(dx=1.0 / 64.0, xi=0.01, rho_slab=2400.0, precision="float32")
+    sim = mw.Simulation(as_plane_strain(sc), device=DEVICE)
+    sim.step_to(0.03)
+    now = sim.state.arrays()
+    old = dict(now, hzz=np.zeros(sim.model.n_particles, now["hzz"].dtype))
+    for g in sim.model.groups:
+        if g.plastic_start >= 0:
+            old["hzz"][g.start:g.end] = now["hzz"][g.plastic_start:g.plastic_start + g.count]
+    fresh = mw.Simulation(as_plane_strain(sc), device=DEVICE)
+    fresh.state.load_arrays(old)
+    for k, a in fresh.state.arrays().items():
+        np.testing.assert_array_equal(a, now[k], err_msg=k)
