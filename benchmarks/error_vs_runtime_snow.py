@@ -11,7 +11,9 @@ this machine's CPU in 2D (plane strain), float32:
   from the base run's 0.7 m cut to the far end zone (1.2 m), the touchdown distance and the collapse
   height of the base run;
 - ``shear``: the shear test of SI Note 2 (``shear_test``) at 3, 6, 12, 24 cells across its 3 cm
-  layer. Quantities: peak, softening slip ``delta_s``, collapse at the end of the 8 mm push.
+  layer. Quantities: peak, softening slip ``delta_s`` (to the bond's loss in the layer's interior, at least
+  one layer thickness from the sample's ends) and ``delta_s_whole_layer`` (to the whole layer's, which waits
+  for the traction-free ends), collapse at the end of the 8 mm push.
 
 Per quantity: the error of each level against the finest, against a Richardson extrapolation of the
 three finest where the observed order allows it (0.5 <= p <= 4, monotone), each level's wall time
@@ -63,9 +65,9 @@ PST_DX = [0.02, 0.01, 0.005, 0.0025]
 PST_BRACKET = dict(lo=0.1, hi=0.7, tol=0.02)
 SHEAR_CELLS = [3, 6, 12, 24]
 QUANTITIES = {"pst": ("critical_cut", "speed", "touchdown", "collapse_height"),
-              "shear": ("peak", "delta_s", "collapse")}
+              "shear": ("peak", "delta_s", "delta_s_whole_layer", "collapse")}
 UNITS = {"critical_cut": "m", "speed": "m/s", "touchdown": "m", "collapse_height": "m", "peak": "Pa",
-         "delta_s": "m", "collapse": "1"}
+         "delta_s": "m", "delta_s_whole_layer": "m", "collapse": "1"}
 
 
 def pst_level(dx: float, precision: str, bracket: dict, device: str) -> dict:
@@ -162,7 +164,8 @@ def shear_level(cells: int, precision: str, device: str) -> dict:
     rr = mw.run("shear_test", device=device, overrides=[f"scene.dx={dx!r}", f'precision="{precision}"'])
     r = rr.scene_result
     return {"dx": dx, "cells_across_layer": cells, "precision": precision, "peak": r["peak_shear_stress"],
-            "delta_s": r["softening_displacement"], "collapse": r["collapse_fraction"],
+            "delta_s": r["softening_displacement"], "delta_s_whole_layer": r["softening_displacement_whole_layer"],
+            "collapse": r["collapse_fraction"],
             "wall_time_s": rr.wall_time, "steps": rr.steps, "n_particles": rr.n_particles,
             "particle_steps_per_s": rr.particle_steps_per_s}
 

@@ -15,7 +15,8 @@ __all__ = ["ShearSummary", "shear_summary", "shear_curves", "analyze_shear_serie
 
 def shear_curves(params: ShearTestParams, times, series: dict) -> dict[str, np.ndarray]:
     """Curves of the pushing phase: ``u`` (m, the block's shear displacement), ``slip`` (m, the layer's own),
-    ``gamma`` (slip over ``D_wl``), ``tau`` (Pa), ``q`` (Pa), ``axial`` (-), ``bond`` (-), ``t`` (s).
+    ``gamma`` (slip over ``D_wl``), ``tau`` (Pa), ``q`` (Pa), ``axial`` (-), ``bond`` (-), ``bond_interior``
+    (-; the whole layer's for a series without it), ``t`` (s).
 
     Displacements are taken relative to the state when the push starts; ``axial`` is the thickness loss
     over ``D_wl`` (positive = compaction).
@@ -29,29 +30,36 @@ def shear_curves(params: ShearTestParams, times, series: dict) -> dict[str, np.n
 
     u, v, slip = part("shear_displacement"), part("normal_displacement"), part("layer_slip")
     u, slip = u - u[0], slip - slip[0]
+    bond = part("bond", 1.0)
     return {"t": t[i0:], "u": u, "slip": slip, "gamma": slip / d_wl, "tau": part("shear_stress"),
-            "q": part("mises_q"), "axial": -(v - v[0]) / d_wl, "bond": part("bond", 1.0)}
+            "q": part("mises_q"), "axial": -(v - v[0]) / d_wl, "bond": bond,
+            "bond_interior": part("bond_interior") if "bond_interior" in series else bond}
 
 
 def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
     """Peak and residual strength, softening displacement and collapse of a shear test, with references.
 
     On the layer's slip (:func:`shear_curves`): the peak and the residual of :func:`shear_summary`; the
-    softening displacement ``delta_s`` is the slip from the peak to the loss of the bond (the layer's
-    mean bond at zero: the end of the strength drop, before the collapse and the frictional residual);
-    the same on the block's displacement (``plate_``) for comparison with the loading-plate measurement
-    of a shear test. The collapse is given beside two laws: ``collapse_fraction_law`` (oedometric, the
-    debonded layer under the slab at rest) and ``collapse_fraction_critical_state`` (the debonded,
-    cohesionless layer at the critical state of its final mean Kirchhoff pressure ``p_final``: ``p0 =
-    2 p``; a sheared layer compacts more, MODEL.md 3b). The calibrated layer's predictions
-    (:meth:`ShearTestParams.references`) are copied in.
+    softening displacement ``delta_s`` is the slip from the peak to the loss of the bond (the mean bond of the
+    layer's interior, at least ``D_wl`` from the sample's ends, at zero: the end of the strength drop, before
+    the collapse and the frictional residual); the same on the block's displacement (``plate_``) for comparison
+    with the loading-plate measurement of a shear test, and ``softening_displacement_whole_layer`` to the whole
+    layer's bond at zero, which waits for the traction-free ends: it grows as dx falls (3, 6, 12, 24 cells:
+    2.13, 2.17, 2.26, 2.45 mm) because the last column to debond sits ever closer to an end. The collapse is
+    given beside two laws: ``collapse_fraction_law`` (oedometric, the debonded layer under the slab at rest) and
+    ``collapse_fraction_critical_state`` (the debonded, cohesionless layer at the critical state of its final
+    mean Kirchhoff pressure ``p_final``: ``p0 = 2 p``; a sheared layer compacts more, MODEL.md 3b). The
+    calibrated layer's predictions (:meth:`ShearTestParams.references`) are copied in.
     """
     c = shear_curves(params, times, series)
     if len(c["u"]) < 3:
         return {}
     sm = shear_summary(c["slip"], c["tau"], c["axial"])
-    lost = np.nonzero((np.arange(len(c["bond"])) > sm.peak_index) & (c["bond"] <= 0.0))[0]
+    after_peak = np.arange(len(c["bond"])) > sm.peak_index
+    lost_all = np.nonzero(after_peak & (c["bond"] <= 0.0))[0]
+    lost = np.nonzero(after_peak & (c["bond_interior"] <= 0.0))[0]
     k = int(lost[0]) if len(lost) else -1
+    k_all = int(lost_all[0]) if len(lost_all) else -1
     ip = sm.peak_index
     refs = params.references()
     mat = params.calibrated().material
@@ -62,6 +70,8 @@ def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
     return {"peak_shear_stress": sm.peak_stress, "residual_shear_stress": sm.residual_stress,
             "peak_slip": float(c["slip"][ip]),
             "softening_displacement": float(c["slip"][k] - c["slip"][ip]) if k >= 0 else math.nan,
+            "softening_displacement_whole_layer":
+                float(c["slip"][k_all] - c["slip"][ip]) if k_all >= 0 else math.nan,
             "plate_softening_displacement": float(c["u"][k] - c["u"][ip]) if k >= 0 else math.nan,
             "bond_lost": k >= 0, "collapse_fraction": sm.collapse_fraction,
             "collapse_fraction_critical_state": float(cs), "p_final": p_end, "peak_q": float(np.max(c["q"])),

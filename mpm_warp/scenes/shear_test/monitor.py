@@ -30,7 +30,10 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
     nodes), ``mises_q``/``p_mean`` (Pa, mean Mises stress and pressure of the weak layer, Cauchy), ``p_kirchhoff``
     (Pa, its mean Kirchhoff pressure, the yield function's),
     ``collapse`` (-, mean ``1 - J_P/J_P,ref`` of the layer), ``bond`` (-, the layer's mean bond
-    ``1 - kappa/kappa_s``) and ``damaged_fraction`` (-, bond at or below one half). Per-frame particle
+    ``1 - kappa/kappa_s``), ``bond_interior`` (-, the same away from the sample's ends: particles placed at
+    least one layer thickness ``D_wl`` from both; the traction-free ends debond last, the closer to the end
+    the later, so the whole layer's bond reaches zero later the finer the columns) and ``damaged_fraction``
+    (-, bond at or below one half). Per-frame particle
     field (with ``log_jp`` in the output): ``log_jp_ref``, the collapse reference.
     """
 
@@ -39,7 +42,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
              "axial_strain": "1",
              "layer_shear_stress": "Pa", "shear_stress": "Pa", "mises_q": "Pa", "p_mean": "Pa", "p_kirchhoff": "Pa",
              "collapse": "1",
-             "bond": "1", "damaged_fraction": "1"}
+             "bond": "1", "bond_interior": "1", "damaged_fraction": "1"}
 
     def __init__(self, sim):
         super().__init__()
@@ -61,6 +64,9 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
         self.top_row = np.nonzero(y0 >= y0.max() - 1e-9)[0]
         self.bottom_row = np.nonzero(y0 <= y0.min() + 1e-9)[0]
         self.row_span = float(y0.max() - y0.min())
+        x0 = self.weak.group.x0[:, 0]
+        d_wl = float(p.weak_layer_thickness)
+        self.interior = np.nonzero((x0 >= x0.min() + d_wl) & (x0 <= x0.max() - d_wl))[0]
 
     def actions(self) -> list:
         """The weak layer's bookkeeping, then the push, every step."""
@@ -94,7 +100,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
                 "mises_q": float(np.mean(q[wl.start:wl.end])), "p_mean": float(np.mean(p[wl.start:wl.end])),
                 "p_kirchhoff": float(np.mean(p_k)),
                 "collapse": float(np.mean(c)), "bond": float(np.mean(bond)),
-                "damaged_fraction": float(np.mean(bond <= 0.5))}
+                "bond_interior": float(np.mean(bond[self.interior])), "damaged_fraction": float(np.mean(bond <= 0.5))}
 
     def device_state(self) -> dict[str, np.ndarray]:
         """Weak-layer reference and damage times, the push impulse and the last frame's (time, impulse)."""
