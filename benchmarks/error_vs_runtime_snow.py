@@ -288,6 +288,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     data = load(a.results)
     data["environment"] = environment(a.device)
+    commit = data["environment"].get("git_commit")   # the code this process runs (it may change while it runs)
     ladders = ["shear", "pst"] if a.ladder == "both" else [a.ladder]
     for ladder in ladders:
         n = len(PST_DX if ladder == "pst" else SHEAR_CELLS)
@@ -313,7 +314,7 @@ def main(argv=None) -> int:
             else:
                 rec = shear_level(SHEAR_CELLS[i], prec, a.device)
             rec["level"], rec["device"] = i, a.device     # a level run on a GPU is not a CPU wall time
-            rec["git_commit"] = environment(a.device).get("git_commit")   # levels may come from different runs
+            rec["git_commit"] = commit                    # levels may come from different runs
             data = load(a.results)     # merged into what is there now: another process may have written levels
             data["environment"] = environment(a.device)
             have = data["ladders"].setdefault(ladder, [])
