@@ -28,6 +28,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import sys
@@ -75,29 +76,38 @@ def figure(data: dict, path: str) -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    for ax, (key, xlabel, xscale, x_of) in zip(axes, (
-            ("slab.E", "slab Young's modulus E [MPa]", 1e-6, lambda r: r["value"]),
-            ("weak_layer.h_c", "measured collapse height h_f [mm]", 1e3, lambda r: r["collapse_height"])),
-            strict=True):
+    for ax, (key, xlabel, xscale) in zip(axes, (("slab.E", "slab Young's modulus E [MPa]", 1e-6),
+                                                 ("weak_layer.h_c", "weak layer's collapse height h_c [mm]", 1e3)),
+                                          strict=True):
         rows = data["trends"][key]["cases"]
-        x = np.array([x_of(r) for r in rows]) * xscale
-        ax.plot(x, [r["speed"] for r in rows], "o-", color="C3",
+        x = np.array([r["value"] if key == "slab.E" else r["h_c_calibrated"] for r in rows]) * xscale
+        ran = np.array([bool(r["propagated"]) for r in rows])
+        ax.plot(x[ran], [r["speed"] for r, k in zip(rows, ran, strict=True) if k], "o-", color="C3",
                 label=f"damage front, mean {CUT:g}-{rows[0]['speed_over'][1]:.1f} m "
                       f"(slope {data['trends'][key]['slope_speed']:+.2f})")
-        ax.plot(x, [r["heierli_speed_run"] for r in rows], "s--", color="C2",
-                label=f"Heierli, run's collapse (slope {data['trends'][key]['slope_heierli']:+.2f})")
+        ax.plot(x[ran], [r["heierli_speed_run"] for r, k in zip(rows, ran, strict=True) if k], "s--", color="C2",
+                label=f"Heierli, run's collapse (slope {data['trends'][key]['slope_heierli']:+.2f})"
+                      + ("" if key == "slab.E" else "\n(slopes against the measured collapse)"))
+        for r, xv, k in zip(rows, x, ran, strict=True):
+            if not k:
+                ax.annotate(f"no crack from a {CUT:g} m cut\n(front stopped at {r['front']:.2f} m)",
+                            (xv, FIELD_SPEED[0]), xytext=(5, 20), textcoords="offset points", fontsize=8,
+                            arrowprops=dict(arrowstyle="->"))
         ax.axhspan(*FIELD_SPEED, color="0.88", label="field 20-30 m/s")
         ax.set(xscale="log", yscale="log", xlabel=xlabel, ylabel="crack speed [m/s]")
         for axis in (ax.xaxis, ax.yaxis):
             axis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
             axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xticks(x)
+        ax.set_xlim(x.min() / 1.15, x.max() * 1.15)
+        ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
         ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%.3g"))
         lo, hi = ax.get_ylim()
-        ax.set_yticks([v for v in (5, 10, 15, 20, 25, 30, 40, 50, 60, 80, 100, 150) if lo <= v <= hi])
+        ax.set_yticks([v for v in (5, 10, 12.5, 15, 17.5, 20, 22.5, 25, 30, 40, 50, 60, 80, 100, 150)
+                       if lo <= v <= hi])
         ax.legend(fontsize=8)
     axes[0].set_title("speed against slab stiffness (h_c: WEAC fit)", fontsize=9)
-    axes[1].set_title("speed against collapse height (h_c x 0.5, 1, 2; E = 5 MPa)", fontsize=9)
+    axes[1].set_title("speed against collapse height (h_c x 0.5, 1, 2 of the WEAC fit; E = 5 MPa)", fontsize=9)
     fig.suptitle("PST (2.2 m column, 0.3 m slab, 6 cm layer at 6 cells, cut 0.7 m): one parameter at a time",
                  fontsize=9)
     fig.tight_layout()
@@ -110,7 +120,12 @@ def main(argv=None) -> int:
     ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--device", default="cpu")
+    ap.add_argument("--figure-only", action="store_true", help="redraw the figure from the JSON")
     a = ap.parse_args(argv)
+    if a.figure_only:
+        with open(os.path.join(RESULTS, "snow_speed_trends.json")) as fh:
+            figure(json.load(fh), os.path.join(RESULTS, "snow_speed_trends.png"))
+        return 0
     from mpm_warp.scenes.references import weac_collapse_height
 
     h_fit = weac_collapse_height(0.06)
@@ -126,6 +141,7 @@ def main(argv=None) -> int:
         trends[key] = {"cases": members, "slope_speed": slope(x, [r["speed"] for r in members]),
                        "slope_heierli": slope(x, [r["heierli_speed_run"] for r in members]),
                        "heierli_exponent": 0.25 if key == "slab.E" else -0.25,
+                       "arrested": [r["value"] for r in members if not r["propagated"]],
                        "monotone": bool(np.all(np.diff([r["speed"] for r in members]) *
                                                (1 if key == "slab.E" else -1) > 0))}
     data = {"trends": trends, "column": COLUMN, "cut": CUT, "h_c_fit": h_fit, "wall_s": time.perf_counter() - t0,
