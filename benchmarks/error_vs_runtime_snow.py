@@ -185,13 +185,17 @@ def richardson(h, v):
 
 def time_to(errors, walls, target: float) -> dict:
     """Wall time (s) to ``target`` error along the ladder (coarse to fine), log-log interpolated."""
-    # CPU wall times only: a level run on a GPU (wall time nan here) still serves as the reference
-    pts = [(e, w) for e, w in zip(errors, walls, strict=True) if np.isfinite(e) and (np.isfinite(w) or e == 0.0)]
-    if not pts:
+    # CPU wall times only: a level run on a GPU (wall time nan here) still serves as the reference. A level
+    # without a value (a PST whose crack did not run) has not reached any target: its error counts as infinite
+    if not any(np.isfinite(e) for e in errors):
         return {"status": "no data"}
+    pts = [(e if np.isfinite(e) else math.inf, w) for e, w in zip(errors, walls, strict=True)
+           if np.isfinite(w) or e == 0.0]
     if pts[0][0] <= target:
         return {"status": "already at the coarsest", "wall_time_s": pts[0][1]}
     for (e1, w1), (e2, w2) in zip(pts, pts[1:], strict=False):
+        if math.isinf(e1) and target >= e2:
+            return {"status": "first met where the quantity first exists", "wall_time_s": w2}
         if e1 > target >= e2 and e2 > 0:
             s = (math.log(target) - math.log(e1)) / (math.log(e2) - math.log(e1))
             return {"status": "interpolated", "wall_time_s": math.exp(math.log(w1) + s * (math.log(w2) - math.log(w1)))}
