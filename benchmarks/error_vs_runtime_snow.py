@@ -236,7 +236,7 @@ def figure(data: dict, path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.6))
     for ax, ladder in zip(axes, ("pst", "shear"), strict=True):
         lv = [x for x in data["ladders"].get(ladder, []) if x["precision"] == "float32"]
         summ = data["summary"].get(ladder, {})
@@ -250,8 +250,13 @@ def figure(data: dict, path: str) -> None:
                    if np.isfinite(ee) and ee > 0 and w.get("device", "cpu") == "cpu"]
             if pts:
                 drawn = True
+                # an error against the finest level falls towards it even when the quantity does not converge:
+                # say so where the changes between levels grow
+                ch = np.abs(np.diff([v for v in summ[q]["values"] if np.isfinite(v)]))
+                grows = len(ch) >= 2 and bool(np.all(np.diff(ch) > 0))
                 ax.loglog(*zip(*pts, strict=True), "o-", color=f"C{k}",
-                          label=f"{q} (vs {'Richardson' if use_r else 'finest'})")
+                          label=f"{q} (vs {'Richardson' if use_r else 'finest'})"
+                                + (": changes grow, not converging" if grows else ""))
         for t in TARGETS:
             ax.axhline(t, color="0.6", ls=":", lw=1)
         ax.set(xlabel="wall time of the level [s] (CPU, 2D, float32)", ylabel="relative error",
@@ -263,7 +268,7 @@ def figure(data: dict, path: str) -> None:
             ax.text(0.02, 0.02, "\n".join(missing), transform=ax.transAxes, fontsize=8, va="bottom")
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         if drawn:
-            ax.legend(fontsize=8)
+            ax.legend(fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
