@@ -120,7 +120,10 @@ def pst_base_level(dx: float, precision: str, device: str, workdir: str) -> dict
 
     def started(sim):
         now.update(t0=time.perf_counter(), steps_from=sim.stepper.clock()[2])
-        sessions.append({"wall_time_s": 0.0, "steps": 0, "t_end": sim.time, "done": False})
+        # the code of each session: a resume in a later session runs the code of its day (the same physics;
+        # rounding may differ, so the level is one run only where every session ran one commit)
+        sessions.append({"wall_time_s": 0.0, "steps": 0, "t_end": sim.time, "done": False, "t_start": sim.time,
+                         "git_commit": environment(device).get("git_commit")})
 
     def running(sim, frame):                      # False stops the run: the front reached the end zone
         front_in = sim.monitors["pst"].damage_front(sim.time) >= goal
