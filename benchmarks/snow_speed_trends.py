@@ -5,7 +5,7 @@ On the PST of the error-against-run-time ladder at its 6-cell level (2.2 m colum
 weak layer, dx 10 mm; everything else ``pst_flat``), one parameter is changed at a time around the
 centre case:
 
-- the slab's Young's modulus ``E``: 2.5, 5 (centre), 10 MPa (density fixed);
+- the slab's Young's modulus ``E``: 1.25, 2.5, 5 (centre), 7.5, 10 MPa (density fixed);
 - the weak layer's collapse height ``h_c`` (a field quantity of the calibration,
   :mod:`mpm_warp.scenes.weak_layer.calibration`): 0.5, 1 (centre: the WEAC fit, 4.7 mm for 6 cm),
   2 times the fit.
@@ -42,7 +42,7 @@ from common import RESULTS, dask_map, environment, write_json  # noqa: E402
 from snow_wf_sweep import COLUMN, FIELD_SPEED  # noqa: E402
 
 CUT = 0.7                                   # m: the saw's stop, beyond every case's critical cut
-SLAB_E = (2.5e6, 5.0e6, 1.0e7)              # Pa
+SLAB_E = (1.25e6, 2.5e6, 5.0e6, 7.5e6, 1.0e7)  # Pa
 H_C_FACTORS = (0.5, 1.0, 2.0)               # of the WEAC fit of the layer's thickness
 
 
