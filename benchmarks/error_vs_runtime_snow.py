@@ -109,7 +109,8 @@ def pst_base_level(dx: float, precision: str, device: str, workdir: str) -> dict
                                                    "time.frame_interval=0.01"])
     p = sc.scene
     goal = p.length - end_zone(p)                 # base_run_distance = length: into the end zone
-    t_stop = p.saw_start + cut / p.saw.speed + 0.5
+    t_saw_end = p.saw_start + cut / p.saw.speed
+    t_stop = t_saw_end + 0.5
     os.makedirs(workdir, exist_ok=True)
     path = os.path.join(workdir, f"pst_dx{dx:g}_{precision}.h5")
     log_path = path[:-3] + ".sessions.json"
@@ -126,7 +127,10 @@ def pst_base_level(dx: float, precision: str, device: str, workdir: str) -> dict
                          "git_commit": environment(device).get("git_commit")})
 
     def running(sim, frame):                      # False stops the run: the front reached the end zone
-        front_in = sim.monitors["pst"].damage_front(sim.time) >= goal
+        # as the critical-cut search's base run: the saw reaches the cut first, the front is checked from the
+        # first frame after it (a crack that outruns the saw does not end the run early: the collapse height is
+        # that of the run's last frame)
+        front_in = sim.time >= t_saw_end + 0.01 - 1e-9 and sim.monitors["pst"].damage_front(sim.time) >= goal
         sessions[-1].update(wall_time_s=time.perf_counter() - now["t0"], t_end=sim.time,
                             steps=sim.stepper.clock()[2] - now["steps_from"],
                             done=bool(front_in or sim.time >= t_stop - 1e-9))
