@@ -32,6 +32,8 @@ Usage (hours on 2 CPU cores; the finest PST level dominates)::
     .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --device cuda:0   # on a GPU
     .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --base-only \
         --workdir runs/   # the 24-cell base run on the CPU, over several sessions (rerun to resume)
+    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --pst-bracket 0.30625 0.34375 \
+        --workers 2 --threads 2   # its critical cut, bisected where the coarser levels put it (one trial each side)
 
 A level run on a GPU records its device and serves as a reference; the wall times to 5 % and 1 % are
 this CPU's only.
@@ -66,15 +68,20 @@ PST_BRACKET = dict(lo=0.1, hi=0.7, tol=0.02)
 SHEAR_CELLS = [3, 6, 12, 24]
 QUANTITIES = {"pst": ("critical_cut", "speed", "touchdown", "collapse_height"),
               "shear": ("peak", "delta_s", "delta_s_whole_layer", "collapse")}
+#: what a narrowed critical-cut search adds to a level's base-only record
+PST_CUT_FIELDS = ("critical_cut", "critical_cut_bracket", "bracketed", "critical_cut_note", "trials",
+                  "critical_cut_wall_s", "critical_cut_steps", "bisection")
 UNITS = {"critical_cut": "m", "speed": "m/s", "touchdown": "m", "collapse_height": "m", "peak": "Pa",
          "delta_s": "m", "delta_s_whole_layer": "m", "collapse": "1"}
 
 
-def pst_level(dx: float, precision: str, bracket: dict, device: str) -> dict:
+def pst_level(dx: float, precision: str, bracket: dict, device: str, workers: int = 1,
+              n_threads: int | None = None) -> dict:
     """One PST level: critical cut by bisection, and the base run's speed, touchdown and collapse height."""
     sc = mw.load_scenario("pst_flat", PST_SCENE + [f"scene.dx={dx!r}", f'precision="{precision}"'])
     t0 = time.perf_counter()
     res = critical_cut(sc, device=device, base_run_distance=sc.scene.length, base_free_run=0.5, **bracket,
+                       workers=workers, n_threads=n_threads,
                        log=lambda s: print(f"  pst dx {dx}: {s}", flush=True))
     wall = time.perf_counter() - t0
     b = res.base
@@ -89,6 +96,83 @@ def pst_level(dx: float, precision: str, bracket: dict, device: str) -> dict:
             "particle_steps_per_s": n_particles * steps / wall,
             "simulated_s": float(sum(t["t_end"] - t["t_start"] for t in res.trials)),
             "bisection": bracket}
+
+
+def grid_bracket(lo: float, hi: float) -> dict:
+    """A bracket inside :data:`PST_BRACKET` on its bisection grid, for a level whose cut the coarser levels bound.
+
+    ``lo`` and ``hi`` must be points the full search can visit (``PST_BRACKET``'s ``lo`` plus a multiple of its
+    width over a power of two), so that the bisection ends in one of the full search's final brackets:
+    the level's critical cut reads as at the other levels, at the cost of the trials inside ``[lo, hi]``
+    only. A cut outside ``[lo, hi]`` is reported as not bracketed.
+    """
+    b = PST_BRACKET
+    w = b["hi"] - b["lo"]
+    n = 0
+    while w / 2 ** n > b["tol"]:
+        n += 1
+    for name, x in (("lo", lo), ("hi", hi)):
+        k = (x - b["lo"]) / w * 2 ** n
+        if not (b["lo"] <= x <= b["hi"] and abs(k - round(k)) < 1e-6):
+            raise ValueError(f"--pst-bracket {name} = {x} m: not on the bisection grid of {b} "
+                             f"({b['lo']} + k * {w / 2 ** n:g} m, inside [{b['lo']}, {b['hi']}])")
+    if not lo < hi:
+        raise ValueError(f"--pst-bracket: need lo < hi (got {lo}, {hi})")
+    return dict(lo=lo, hi=hi, tol=b["tol"])
+
+
+def pst_cut_level(dx: float, precision: str, bracket: dict, device: str, workers: int,
+                  n_threads: int | None) -> dict:
+    """A PST level's critical cut searched inside a narrowed ``bracket`` (:func:`grid_bracket`).
+
+    The base run saws to the bracket's top only, so its speed, touchdown and collapse height are not the
+    ladder's (those come from the level's 0.7 m base run, :func:`pst_base_level`): only the critical cut,
+    its trials and the search's wall time are returned.
+    """
+    sc = mw.load_scenario("pst_flat", PST_SCENE + [f"scene.dx={dx!r}", f'precision="{precision}"'])
+    t0 = time.perf_counter()
+    res = critical_cut(sc, device=device, **bracket, workers=workers, n_threads=n_threads,
+                       log=lambda s: print(f"  pst dx {dx}: {s}", flush=True))
+    wall = time.perf_counter() - t0
+    steps = int(sum(t["steps"] for t in res.trials))
+    n_particles = estimate_memory(sc, device).n_particles
+    return {"dx": dx, "cells_across_layer": sc.scene.weak_layer_thickness / dx, "precision": precision,
+            "critical_cut": res.value if res.bracketed else math.nan, "critical_cut_bracket": [res.lo, res.hi],
+            "bracketed": res.bracketed, "critical_cut_note": res.note, "trials": res.trials,
+            "critical_cut_wall_s": wall, "critical_cut_steps": steps,
+            "bisection": {**bracket, "narrowed_from": dict(PST_BRACKET), "workers": workers, "n_threads": n_threads},
+            "speed": math.nan, "speed_over": [math.nan, math.nan], "touchdown": math.nan, "collapse_height": math.nan,
+            "wall_time_s": wall, "n_particles": n_particles, "steps": steps,
+            "particle_steps_per_s": n_particles * steps / wall, "part": "critical_cut",
+            "note": "critical cut only (narrowed bracket); the level's base run is a separate --base-only run"}
+
+
+def _part(rec: dict) -> str:
+    """Which runs of a PST level a record holds: ``both``, ``base_run`` or ``critical_cut``."""
+    return rec.get("part") or ("base_run" if rec.get("note", "").startswith("base run only") else "both")
+
+
+def merge_pst_parts(new: dict, old: dict | None) -> dict:
+    """One level's record from its base run (:func:`pst_base_level`) and its narrowed critical-cut search
+    (:func:`pst_cut_level`), run apart in either order; ``old`` is what the JSON holds for the level.
+
+    Once both are there the level's wall time and steps are both runs' (``part``: ``both``); until then
+    the record says which part it holds, and the other part's quantities are nan.
+    """
+    parts = {_part(new): new}
+    if old is not None and _part(old) != "both" and _part(old) != _part(new):
+        parts[_part(old)] = old
+    if len(parts) == 1:
+        return {**new, "part": _part(new)}
+    base, cut = parts["base_run"], parts["critical_cut"]
+    out = {**base, **{k: cut[k] for k in PST_CUT_FIELDS}, "part": "both",
+           "note": "base run (speed, touchdown, collapse height) and critical-cut search (narrowed bracket) run "
+                   "apart: the level's wall time and steps are both runs'",
+           "git_commit_base_run": base.get("git_commit"), "git_commit": cut.get("git_commit"),
+           "wall_time_s": base["wall_time_s"] + cut["critical_cut_wall_s"],
+           "steps": base["steps"] + cut["critical_cut_steps"]}
+    out["particle_steps_per_s"] = out["n_particles"] * out["steps"] / out["wall_time_s"]
+    return out
 
 
 def pst_base_level(dx: float, precision: str, device: str, workdir: str) -> dict | None:
@@ -161,7 +245,7 @@ def pst_base_level(dx: float, precision: str, device: str, workdir: str) -> dict
             "speed": r["damage_speed_mean"], "speed_over": r["damage_speed_mean_over"], "touchdown": r["touchdown"],
             "collapse_height": r["collapse_height"], "wall_time_s": wall, "n_particles": n_particles,
             "steps": steps, "particle_steps_per_s": n_particles * steps / wall, "simulated_s": last["t_end"],
-            "sessions": len(sessions), "run_file": path}
+            "sessions": len(sessions), "run_file": path, "part": "base_run"}
 
 
 def shear_level(cells: int, precision: str, device: str) -> dict:
@@ -301,6 +385,12 @@ def main(argv=None) -> int:
                     help="PST: the base run alone (no critical cut), checkpointed in --workdir and resumed by the "
                          "same command after a kill (for the 24-cell level: about 8 h on a 2-core CPU)")
     ap.add_argument("--workdir", default="error_vs_runtime_snow_runs", help="run files of --base-only")
+    ap.add_argument("--pst-bracket", type=float, nargs=2, metavar=("LO", "HI"),
+                    help="PST: the critical cut alone, bisected inside [LO, HI] m (points of the full bracket's "
+                         "bisection grid), merged into the level's base-only record (for the 24-cell level on a CPU)")
+    ap.add_argument("--workers", type=int, default=1, choices=(1, 2),
+                    help="PST critical cut: 2 runs the trials of the bracket's bottom and first midpoint at once")
+    ap.add_argument("--threads", type=int, default=None, help="CPU threads of each simulation")
     a = ap.parse_args(argv)
     data = load(a.results)
     data["environment"] = environment(a.device)
@@ -315,10 +405,14 @@ def main(argv=None) -> int:
         have = data["ladders"].setdefault(ladder, [])
         for i, prec in jobs:
             done = [x for x in have if x.get("level") == i and x["precision"] == prec]
-            if done and not a.redo:
+            want = "critical_cut" if ladder == "pst" and a.pst_bracket else "base_run" if ladder == "pst" and \
+                a.base_only else "both"
+            if done and not a.redo and _part(done[0]) in (want, "both"):
                 continue
             print(f"{ladder} level {i} ({prec})", flush=True)
-            if ladder == "pst" and a.base_only:
+            if ladder == "pst" and a.pst_bracket:
+                rec = pst_cut_level(PST_DX[i], prec, grid_bracket(*a.pst_bracket), a.device, a.workers, a.threads)
+            elif ladder == "pst" and a.base_only:
                 rec = pst_base_level(PST_DX[i], prec, a.device, a.workdir)
                 if rec is None:
                     print(f"pst level {i}: stopped before its end; the same command resumes it", flush=True)
@@ -326,7 +420,7 @@ def main(argv=None) -> int:
             elif ladder == "pst":
                 # one bracket for every level: the base run saws to its top, so the speed is measured over
                 # the same distance at every level
-                rec = pst_level(PST_DX[i], prec, dict(PST_BRACKET), a.device)
+                rec = pst_level(PST_DX[i], prec, dict(PST_BRACKET), a.device, a.workers, a.threads)
             else:
                 rec = shear_level(SHEAR_CELLS[i], prec, a.device)
             rec["level"], rec["device"] = i, a.device     # a level run on a GPU is not a CPU wall time
@@ -334,6 +428,9 @@ def main(argv=None) -> int:
             data = load(a.results)     # merged into what is there now: another process may have written levels
             data["environment"] = environment(a.device)
             have = data["ladders"].setdefault(ladder, [])
+            if ladder == "pst" and (a.pst_bracket or a.base_only):    # the level's other part, when there
+                other = [x for x in have if x.get("level") == i and x["precision"] == prec]
+                rec = merge_pst_parts(rec, other[0] if other else None)
             have[:] = [x for x in have if not (x.get("level") == i and x["precision"] == prec)] + [rec]
             have.sort(key=lambda x: (x["precision"], x["level"]))
             data["summary"] = {k: summarise(k, v) for k, v in data["ladders"].items()}

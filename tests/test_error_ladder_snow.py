@@ -82,3 +82,46 @@ def test_pst_ladder_error_falls_from_3_to_6_cells(pst_levels, quantity):
 
     e3, e6 = error(pst_levels[3][quantity]), error(pst_levels[6][quantity])
     assert e6 < e3, f"{quantity}: error {e3:.3g} at 3 cells, {e6:.3g} at 6 (finest {ref:.6g})"
+
+
+# ----------------------------------------------------------------------------- the benchmark's bookkeeping
+def _bench():
+    import importlib.util
+    import os
+
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks",
+                        "error_vs_runtime_snow.py")
+    spec = importlib.util.spec_from_file_location("error_vs_runtime_snow", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_narrowed_bracket_must_lie_on_the_full_searchs_grid():
+    """A narrowed search ends in one of the full search's final brackets: [0.1, 0.7] m to 2 cm is a grid of
+    0.6 / 32 = 0.01875 m, so 0.30625 and 0.34375 m (points 11 and 13) are allowed and 0.31 m is not."""
+    e = _bench()
+    assert e.grid_bracket(0.30625, 0.34375) == {"lo": 0.30625, "hi": 0.34375, "tol": 0.02}
+    with pytest.raises(ValueError, match="lo = 0.31 m: not on the bisection grid"):
+        e.grid_bracket(0.31, 0.34375)
+    with pytest.raises(ValueError, match="hi = 0.75 m"):
+        e.grid_bracket(0.1, 0.75)
+    with pytest.raises(ValueError, match="need lo < hi"):
+        e.grid_bracket(0.34375, 0.30625)
+
+
+def test_a_levels_base_run_and_critical_cut_merge_in_either_order():
+    e = _bench()
+    base = {"dx": 0.0025, "precision": "float32", "level": 3, "note": "base run only (critical cut not bisected)",
+            "critical_cut": float("nan"), "speed": 22.0, "touchdown": 0.74, "collapse_height": 0.007,
+            "wall_time_s": 8000.0, "steps": 130000, "n_particles": 591360, "git_commit": "a"}
+    cut = {"dx": 0.0025, "precision": "float32", "level": 3, "part": "critical_cut", "critical_cut": 0.315625,
+           "critical_cut_bracket": [0.30625, 0.325], "bracketed": True, "critical_cut_note": "", "trials": [{}],
+           "critical_cut_wall_s": 3000.0, "critical_cut_steps": 100000, "bisection": {"lo": 0.30625},
+           "speed": float("nan"), "wall_time_s": 3000.0, "steps": 100000, "n_particles": 591360, "git_commit": "b"}
+    for merged in (e.merge_pst_parts(cut, base), e.merge_pst_parts({**base, "part": "base_run"}, cut)):
+        assert merged["part"] == "both" and merged["critical_cut"] == 0.315625 and merged["speed"] == 22.0
+        assert merged["wall_time_s"] == 11000.0 and merged["steps"] == 230000
+        assert merged["git_commit"] == "b" and merged["git_commit_base_run"] == "a"
+    assert e.merge_pst_parts(cut, None)["part"] == "critical_cut"
+    assert e.merge_pst_parts({**base, "part": "base_run"}, None)["part"] == "base_run"

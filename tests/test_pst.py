@@ -203,6 +203,41 @@ def test_critical_cut_reports_a_bracket_it_cannot_hold():
     assert all(t["t_end"] == pytest.approx(p.saw_start + t["cut"] / p.saw.speed + 0.005) for t in res.trials)
 
 
+@pytest.mark.parametrize("workers", [1, 2])
+def test_critical_cut_bisects_and_runs_the_first_two_trials_at_once(monkeypatch, workers):
+    """The search's bookkeeping, with each trial's outcome set by its cut (threshold 0.07 m): the bracket,
+    the trials' order and the result are the same with ``workers=2``, whose trials of ``lo`` and the first
+    midpoint must run at the same time (each waits for the other at a barrier)."""
+    import threading
+
+    from mpm_warp.scenes.pst import critical as cc
+
+    real, meet = cc._trial, threading.Barrier(2, timeout=60)
+
+    def trial(sim, mon, cut, run_distance, free_run, check_interval):
+        if workers == 2 and cut in (0.05, 0.5 * (0.05 + 0.1)):
+            meet.wait()                    # BrokenBarrierError unless both run concurrently
+        out = real(sim, mon, cut, run_distance, free_run, check_interval)
+        return {**out, "propagated": cut > 0.07}
+
+    monkeypatch.setattr(cc, "_trial", trial)
+    sc = load_scenario("pst_demo", TINY)
+    res = critical_cut(sc, 0.05, 0.1, tol=0.02, free_run=0.005, run_distance=0.4, device=DEVICE, n_threads=1,
+                       workers=workers)
+    assert res.bracketed and (res.lo, res.hi, res.value) == pytest.approx((0.0625, 0.075, 0.06875), abs=1e-15)
+    assert [t["cut"] for t in res.trials] == pytest.approx([0.1, 0.05, 0.075, 0.0625], abs=1e-15)
+    assert [t["propagated"] for t in res.trials] == [True, False, True, False]
+    # each trial from the last snapshot before its cut, and run to its saw's stop plus the free run
+    p = sc.scene
+    assert all(t["t_end"] == pytest.approx(p.saw_start + t["cut"] / p.saw.speed + 0.005) for t in res.trials[1:])
+    assert all(t["t_start"] <= p.saw_start + t["cut"] / p.saw.speed + 1e-12 for t in res.trials)
+
+
+def test_critical_cut_rejects_three_workers():
+    with pytest.raises(ValueError, match="workers = 3"):
+        critical_cut(load_scenario("pst_demo", TINY), 0.05, 0.1, workers=3)
+
+
 # ----------------------------------------------------------------------------- end to end
 #: pst_demo at 1 cm (3 cells across the layer, the minimum) on a 1.2 m column, settled by 0.05 s, sawn up to
 #: 0.5 m at 1 m/s: 18k particles, 31k steps (about a minute on one core)

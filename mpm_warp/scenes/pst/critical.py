@@ -9,6 +9,11 @@ propagated) or ``free_run`` seconds after the saw stopped (it arrested). Each tr
 run only, never for the settling. The predicate is monotone in the cut, and
 :func:`~mpm_warp.scenes.fronts.bisect_threshold` brackets the critical cut to ``tol``.
 
+With ``workers=2`` the two trials every search needs first, the bracket's bottom ``lo`` and the first
+midpoint, run at the same time in two Python threads (a launch releases the GIL, and each trial has its
+own simulation and grids), so a search of one bisection step costs the base run and one trial's wall
+time on two cores; the trials and the result are those of the serial search.
+
 The result states the bracket, every trial (cut, outcome, how far its damage front got, its
 runaway time) and the base run's one-run estimate (``runaway_cut``, see :mod:`.analysis`).
 """
@@ -17,7 +22,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 import time as _time
+from concurrent.futures import ThreadPoolExecutor
 
 from ...simulation import Simulation
 from ..fronts import bisect_threshold
@@ -82,7 +89,8 @@ def _simulation(scenario, device, n_threads) -> tuple[Simulation, PSTMonitor]:
 def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance: float = 1.0,
                  free_run: float = 0.2, snapshot_every: float | None = None, check_interval: float = 0.01,
                  base_run_distance: float | None = None, base_free_run: float | None = None,
-                 device: str | None = None, n_threads: int | None = None, log=None) -> CriticalCut:
+                 device: str | None = None, n_threads: int | None = None, workers: int = 1,
+                 log=None) -> CriticalCut:
     """Bisect the critical cut of the PST ``scenario`` within ``[lo, hi]`` (m) to ``tol`` (m).
 
     Parameters
@@ -111,7 +119,12 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         Simulated time between the trial's front checks (s); each is a frame of the monitor's series, so
         the ``base`` summary has a touchdown and a collapse height.
     device, n_threads
-        As :class:`~mpm_warp.Simulation`.
+        As :class:`~mpm_warp.Simulation`: ``n_threads`` CPU threads for the base run and each serial trial;
+        the two concurrent trials of ``workers=2`` take half as many each (one each when ``n_threads`` is
+        None), so that they share the cores the base run used.
+    workers : int
+        1: one trial after another. 2: the trials of ``lo`` and the first midpoint run concurrently (the
+        bisection after them is serial, with the same trials as ``1``).
     log : callable, optional
         ``log(str)`` for a line per trial.
     """
@@ -120,6 +133,8 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         raise TypeError("critical_cut needs a PST scenario (scene kind 'pst')")
     if not 0.0 <= lo < hi <= p.length:
         raise ValueError(f"need 0 <= lo < hi <= length (got lo={lo}, hi={hi}, length={p.length})")
+    if workers not in (1, 2):
+        raise ValueError(f"workers = {workers}: need 1 (serial trials) or 2 (lo and the first midpoint at once)")
     wall0 = _time.perf_counter()
     step = float(snapshot_every or 0.5 * tol)
     v, t_saw = float(p.saw.speed), p.saw_start
@@ -143,25 +158,32 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
     if log:
         log(f"cut {hi:.4g} m (base): propagated={base['propagated']}, front {base['front']:.3f} m")
     cache = {hi: base["propagated"]}
+    lock = threading.Lock()
 
-    def propagates(cut: float) -> bool:
+    def propagates(cut: float, threads: int | None = n_threads) -> bool:
         if cut in cache:
             return cache[cut]
         t0 = _time.perf_counter()
         k = max(i for i, (pos, _) in enumerate(snaps) if pos <= cut + 1e-12)
-        tsim, tmon = _simulation(_with_cut(scenario, cut), device, n_threads)
+        tsim, tmon = _simulation(_with_cut(scenario, cut), device, threads)
         tsim.load_snapshot(*snaps[k][1])
         steps0, t_start = tsim.stepper.clock()[2], tsim.time
         out = _trial(tsim, tmon, cut, run_distance, free_run, check_interval)
         out.update(t_start=t_start, steps=tsim.stepper.clock()[2] - steps0, wall=_time.perf_counter() - t0)
-        trials.append(out)
-        cache[cut] = out["propagated"]
-        if log:
-            log(f"cut {cut:.4g} m: propagated={out['propagated']}, front {out['front']:.3f} m "
-                f"({out['wall']:.0f} s)")
+        with lock:
+            trials.append(out)
+            cache[cut] = out["propagated"]
+            if log:
+                log(f"cut {cut:.4g} m: propagated={out['propagated']}, front {out['front']:.3f} m "
+                    f"({out['wall']:.0f} s)")
         return out["propagated"]
 
     runaway = float(base_summary.get("runaway_cut", math.nan))
+    if workers == 2 and cache[hi] and hi - lo > tol:   # the first midpoint, with lo: bisect_threshold's first point
+        with ThreadPoolExecutor(2) as pool:
+            half = max(1, (n_threads or 2) // 2)
+            list(pool.map(lambda c: propagates(c, half), (lo, 0.5 * (lo + hi))))
+        trials[1:] = sorted(trials[1:], key=lambda t: t["cut"] != lo)   # lo's trial first, as in the serial search
     low = propagates(lo)
     if low or not cache[hi]:   # the critical cut is not in the bracket: say which end, keep the trials
         why = f"a cut of {lo:g} m propagated" if low else f"a cut of {hi:g} m arrested"
