@@ -20,6 +20,7 @@ against outcome, with the bracket, beside Gaume et al. 2017's formula):
 Usage::
 
     nohup .venv/bin/python benchmarks/snow_critical_cut.py flat slope ladder_saw_half ladder_slope > cut.log 2>&1 &
+    .venv/bin/python benchmarks/snow_critical_cut.py     # no case: the figure again from the JSON files
 """
 
 from __future__ import annotations
@@ -86,7 +87,12 @@ def ladder_rows() -> dict:
     for lv in levels:
         if lv["precision"] == "float32" and lv.get("bracketed"):
             lo, hi = lv["critical_cut_bracket"]
-            out[f"ladder, dx {1e3 * lv['dx']:g} mm (error ladder)"] = {"trials": lv["trials"], "lo": lo, "hi": hi}
+            sc = mw.load_scenario("pst_flat", LADDER[:-1] + [f"scene.dx={lv['dx']!r}"])
+            label = f"ladder, dx {1e3 * lv['dx']:g} mm (error ladder)"
+            if lv.get("bisection", {}).get("narrowed_from"):
+                label = label[:-1] + ", narrowed)"
+            out[label] = {"trials": lv["trials"], "lo": lo, "hi": hi,
+                          "gaume": sc.scene.references().get("critical_cut_gaume")}
     return out
 
 
@@ -147,10 +153,16 @@ def run_case(name: str, data: dict, device: str) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("cases", nargs="+", choices=list(CASES))
+    ap.add_argument("cases", nargs="*", help=f"any of {', '.join(CASES)} (none: redraw the figure)")
     ap.add_argument("--device", default="cpu")
     a = ap.parse_args(argv)
+    bad = [c for c in a.cases if c not in CASES]
+    if bad:
+        ap.error(f"unknown case(s) {', '.join(bad)}: choose from {', '.join(CASES)}")
     data = load()
+    if not a.cases:                   # the figure again, from the JSON files as they are
+        figure(data, os.path.join(RESULTS, OUT + ".png"))
+        return 0
     for name in a.cases:
         case = run_case(name, data, a.device)
         data = load()                 # merged into what is there now: another process may have written a case
