@@ -14,8 +14,10 @@ The PST ladder's two coarsest levels (2 and 1 cm: 3 and 6 cells across its 6 cm 
 run here, the one that measures the front speed, the touchdown and the collapse height (cut 0.7 m, the
 crack run into the far end zone: :func:`mpm_warp.scenes.pst.cut_run`, as the benchmark's critical-cut
 search runs it); the bisection of the critical cut (about 9 minutes for the two levels) stays in the
-benchmark. At 3 cells the crack does not run at all: there a quantity of the running crack counts as
-100 % wrong, and the ladder's finding (it runs at 6 cells, not at 3) is asserted too.
+benchmark. Their errors are taken against the PST ladder's finest level (24 cells, 2026-11-30: speed
+22.12 m/s, touchdown 0.741 m, collapse height 7.74 mm outside the far end zone). At 3 cells the crack
+does not run at all: there a quantity of the running crack counts as 100 % wrong, and the ladder's
+finding (it runs at 6 cells, not at 3) is asserted too.
 """
 
 import pytest
@@ -32,8 +34,9 @@ FINEST = {"peak": 932.5898344665492, "delta_s": 0.0020884051965618265, "collapse
 #: the PST ladder's scene (benchmarks/error_vs_runtime_snow.py PST_SCENE): production snow, 2.2 m column
 PST_SCENE = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
              "scene.substratum_thickness=0.06", "scene.margin=0.05"]
-#: the PST ladder's finest level (12 cells, dx 5 mm): error_vs_runtime_snow.json
-PST_FINEST = {"speed": 21.477440858616376, "touchdown": 0.727406727195973, "collapse_height": 0.00721748166642367}
+#: the PST ladder's finest level (24 cells, dx 2.5 mm, float32, 2026-11-30): error_vs_runtime_snow.json (the collapse
+#: height outside the far end zone, read from that run's last checkpoint)
+PST_FINEST = {"speed": 22.12034446211075, "touchdown": 0.7413022939415157, "collapse_height": 0.007742506237744472}
 
 
 def _level(cells: int) -> dict:
@@ -60,6 +63,9 @@ def _pst_level(dx: float) -> dict:
     r = cut_run(sc, 0.7, run_distance=sc.scene.length, free_run=0.5, device=DEVICE)
     s = r["summary"]
     assert s["damage_speed_mean_over"] == pytest.approx([0.7, 1.9])   # the benchmark's distance
+    h = r["series"]                                  # a frame every 0.01 s; the collapse height is the last frame's
+    assert len(h["time"]) == len(h["collapse_height"]) and h["time"][-1] == pytest.approx(r["t_end"])
+    assert h["collapse_height"][-1] == s["collapse_height"]
     return {"propagated": r["propagated"], "speed": s.get("damage_speed_mean"), "touchdown": s.get("touchdown"),
             "collapse_height": s.get("collapse_height")}
 
@@ -125,3 +131,18 @@ def test_a_levels_base_run_and_critical_cut_merge_in_either_order():
         assert merged["git_commit"] == "b" and merged["git_commit_base_run"] == "a"
     assert e.merge_pst_parts(cut, None)["part"] == "critical_cut"
     assert e.merge_pst_parts({**base, "part": "base_run"}, None)["part"] == "base_run"
+
+
+def test_time_to_an_error_along_the_ladder():
+    e = _bench()
+    walls = [10.0, 100.0, 1000.0, 10000.0]
+    # log-log between the levels that bracket 5 %: 10 % at 100 s, 2.5 % at 1000 s -> half way in log, 316 s
+    r = e.time_to([0.4, 0.1, 0.025, 0.0], walls, 0.05)
+    assert r["status"] == "interpolated" and r["wall_time_s"] == pytest.approx(1000.0 ** 0.5 * 10.0)
+    assert e.time_to([0.01, 0.005, 0.001, 0.0], walls, 0.05)["status"] == "already at the coarsest"
+    # a critical cut in the same bracket from the third level on: met there, not only at the reference level
+    r = e.time_to([float("nan"), 0.056, 0.0, 0.0], walls, 0.01)
+    assert r == {"status": "met where the value first equals the finest's", "wall_time_s": 1000.0}
+    assert e.time_to([0.3, 0.2, 0.1, 0.0], walls, 0.01) == {"status": "at the finest (the reference)",
+                                                            "wall_time_s": 10000.0}
+    assert e.time_to([0.3, 0.2, 0.1], walls[:3], 0.01)["status"] == "not reached"

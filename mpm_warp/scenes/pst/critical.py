@@ -201,7 +201,8 @@ def cut_run(scenario, cut: float, run_distance: float, free_run: float, check_in
     runs until the damage front is ``run_distance`` (m) beyond the cut (or in the end zone) or
     ``free_run`` (s) has passed since the saw stopped. Returns the trial record (``cut``, ``propagated``,
     ``front``, ``t_end``, ``steps``) with the run's :func:`~.analysis.pst_summary` under ``"summary"`` (front speed,
-    touchdown, collapse height).
+    touchdown, collapse height) and its frame series under ``"series"`` (``time`` in s, then the monitor's
+    scalars, e.g. ``front`` and ``collapse_height`` in m; lists, one entry a frame).
     """
     p = scenario.scene
     if not isinstance(p, PSTParams):
@@ -212,7 +213,9 @@ def cut_run(scenario, cut: float, run_distance: float, free_run: float, check_in
     sim.step_to(p.saw_start)
     _step_recording(sim, mon, p.saw_start + cut / p.saw.speed, check_interval)
     out = _trial(sim, mon, cut, run_distance, free_run, check_interval)
-    return {**out, "steps": sim.stepper.clock()[2], "summary": mon.result()}
+    times, series = mon.series_arrays()
+    return {**out, "steps": sim.stepper.clock()[2], "summary": mon.result(),
+            "series": {"time": times.tolist(), **{k: v.tolist() for k, v in series.items()}}}
 
 
 def _step_recording(sim: Simulation, mon: PSTMonitor, t_end: float, check_interval: float) -> None:

@@ -8,7 +8,7 @@ import warp as wp
 from ..fronts import front_from_arrival, touchdown_distance
 from ..series import SeriesMonitor, entries_below
 from ..weak_layer import ReferenceField, WeakLayerTracker, bin_median
-from .analysis import pst_summary
+from .analysis import end_zone, pst_summary
 from .kernels import deflection_kernel
 from .params import PSTParams
 
@@ -21,10 +21,12 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
     Fronts (distances from the cut end, m; see :mod:`mpm_warp.scenes.pst`): ``front`` (damage: bins
     whose particles' median bond fell to one half), ``deflection_front`` (bins whose slab base came
     down by ``front.deflection`` times the collapse height). Frame scalars (stored in the run file):
-    both fronts, ``saw`` (m), ``collapse_height`` (m: mean collapse of the debonded, unsawn layer times
-    ``D_wl``), ``touchdown`` (m behind the deflection front where the slab base reaches 95 % of its
-    collapsed deflection; nan before the crack runs), ``marker{k}_ux``/``marker{k}_uy`` (m,
-    displacement since t = 0 of the slab-base particle nearest to ``params.markers()[k]``).
+    both fronts, ``saw`` (m), ``collapse_height`` (m: mean collapse of the debonded, unsawn layer outside
+    the far end zone, times ``D_wl``; in the end zone the slab's free end lifts and the layer dilates, by
+    as much as the collapse elsewhere on the ladder PST at 24 cells), ``touchdown`` (m behind the
+    deflection front where the slab base reaches 95 % of its collapsed deflection; nan before the crack
+    runs), ``marker{k}_ux``/``marker{k}_uy`` (m, displacement since t = 0 of the slab-base particle
+    nearest to ``params.markers()[k]``).
     Per-frame particle field (with ``log_jp`` in the output): ``log_jp_ref``, the collapse reference.
 
     Parameters
@@ -48,6 +50,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         self.weak = WeakLayerTracker(sim, "weak_layer", p.saw_start, saw)
         self.h_c = p.calibrated().h_c
         self.s_weak = p.distance_from_cut_end(self.weak.group.x0[:, 0])
+        self.interior = self.s_weak < p.length - end_zone(p)   # the collapse height's particles: not the far end
         # the slab base: its lowest lattice row (all of it in z for the fronts)
         self.slab = sim.group_state("slab")
         x0 = self.slab.x0
@@ -93,7 +96,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         out = {"front": self.damage_front(t),
                "deflection_front": deflection, "saw": self.saw_position(t)}
         c, sawn = self.weak.collapse()
-        gone = (self.weak.bond() <= 0.0) & (sawn == 0)
+        gone = (self.weak.bond() <= 0.0) & (sawn == 0) & self.interior
         out["collapse_height"] = float(np.mean(c[gone]) * p.weak_layer_thickness) if gone.any() else 0.0
         y = self.slab.x.numpy()[self.base_index, 1].astype(np.float64)
         w = self.base_y_ref.numpy() - y
