@@ -26,6 +26,8 @@ import threading
 import time as _time
 from concurrent.futures import ThreadPoolExecutor
 
+import warp as wp
+
 from ...simulation import Simulation
 from ..fronts import bisect_threshold
 from .analysis import end_zone
@@ -123,8 +125,9 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         the two concurrent trials of ``workers=2`` take half as many each (one each when ``n_threads`` is
         None), so that they share the cores the base run used.
     workers : int
-        1: one trial after another. 2: the trials of ``lo`` and the first midpoint run concurrently (the
-        bisection after them is serial, with the same trials as ``1``).
+        1: one trial after another. 2: on a CPU, the trials of ``lo`` and the first midpoint run
+        concurrently (the bisection after them is serial, with the same trials as ``1``); on a GPU, where
+        one run fills the device, the trials stay serial.
     log : callable, optional
         ``log(str)`` for a line per trial.
     """
@@ -179,7 +182,9 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         return out["propagated"]
 
     runaway = float(base_summary.get("runaway_cut", math.nan))
-    if workers == 2 and cache[hi] and hi - lo > tol:   # the first midpoint, with lo: bisect_threshold's first point
+    # on a GPU a run fills the device (and captures CUDA graphs on its stream): trials stay serial there
+    concurrent = workers == 2 and not wp.get_device(sim.device).is_cuda
+    if concurrent and cache[hi] and hi - lo > tol:   # the first midpoint, with lo: bisect_threshold's first point
         with ThreadPoolExecutor(2) as pool:
             half = max(1, (n_threads or 2) // 2)
             list(pool.map(lambda c: propagates(c, half), (lo, 0.5 * (lo + hi))))
