@@ -1,4 +1,4 @@
-"""Error against run time of the reference problems (VALIDATION.md "Error against run time").
+"""Error against run time of the reference problems (docs/validation.md "Error against run time").
 
 For each problem of :data:`mpm_warp.validation.PROBLEMS` (axial bar period,
 self-weight column stress, weak-layer collapse) this runs

@@ -58,7 +58,7 @@ BETA = 0.3
 XI = 0.0066
 #: Initial consolidation pressure (Pa).
 P0_INI = 3.7e3
-#: Floor of p0 relative to K (-), the engine's default (MODEL.md 3).
+#: Floor of p0 relative to K (-), the engine's default (docs/model.md §3).
 P0_FLOOR_RATIO = 1.0e-5
 #: Speed of the oblique strike at the block's edge (m/s).
 IMPACT_SPEED = 10.0
@@ -86,7 +86,7 @@ def p_wave_speed() -> float:
 
 
 def initial_log_jp() -> float:
-    """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (MODEL.md 3)."""
+    """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (docs/model.md §3)."""
     return -math.asinh(P0_INI / lame()[2]) / XI
 
 

@@ -33,8 +33,8 @@ from common import RESULTS, environment, write_json  # noqa: E402
 
 import mpm_warp as mw  # noqa: E402
 
-FIELD_SPEED = (20.0, 30.0)  # m/s, PST crack speeds (Bergfeld et al. 2021; MODEL.md 6)
-FIELD_TOUCHDOWN = 2.7       # m, PST touchdown distance (Bergfeld et al. 2021; MODEL.md 6)
+FIELD_SPEED = (20.0, 30.0)  # m/s, PST crack speeds (Bergfeld et al. 2021; docs/model.md §6)
+FIELD_TOUCHDOWN = 2.7       # m, PST touchdown distance (Bergfeld et al. 2021; docs/model.md §6)
 
 
 def _plt():

@@ -1,4 +1,4 @@
-"""Crack speed against slab stiffness and collapse height (VALIDATION.md, Snow: "speed grows with slab
+"""Crack speed against slab stiffness and collapse height (docs/validation.md, Snow: "speed grows with slab
 stiffness, falls with collapse height").
 
 On the PST of the error-against-run-time ladder at its 6-cell level (2.2 m column, 0.3 m slab, 6 cm

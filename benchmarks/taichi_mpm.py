@@ -6,7 +6,7 @@ one fused ``ti.kernel`` per step whose top-level loops are parallel,
 fields, scene constants folded in as Python floats. Taichi is imported by the
 caller (``taichi_peer.py``) and passed in; this module never imports it.
 
-Constitutive update per particle (MODEL.md 1 and 4)
+Constitutive update per particle (docs/model.md §1 and 4)
 ---------------------------------------------------
 ``F_tr = (I + dt C) F_E``; ``F_tr = U diag(s) V^T`` (``ti.svd``). Elastic:
 ``F_E = F_tr``. Cam-Clay: the return below maps ``s`` to ``s_new`` and
@@ -17,7 +17,7 @@ particles since the total ``F_zz`` is 1): the return sees the three principal
 stretches ``(s_0, s_1, F_zz)`` and the in-plane stress uses ``tr eps`` over all
 three.
 
-The Cam-Clay return is the same algorithm as mpm_warp's (MODEL.md 4): the
+The Cam-Clay return is the same algorithm as mpm_warp's (docs/model.md §4): the
 point of the yield ellipse closest to the trial ``(p, q)`` in the energy metric
 ``dp^2/K + dq^2/(3 mu)``, found in scaled coordinates by Eberly's
 parametrisation with Newton steps from the left end of the root bracket
@@ -108,7 +108,7 @@ def build(ti: Any, n_grid: int, dim: int, material: str) -> SimpleNamespace:
     bound = BOUND
     mass_eps = MASS_EPS
     s_floor = S_FLOOR
-    # Cam-Clay constants (MODEL.md 2-3)
+    # Cam-Clay constants (docs/model.md §2-3)
     M_csl, beta, xi = pb.M_CSL, pb.BETA, pb.XI
     p0_floor = pb.P0_FLOOR_RATIO * K
     x_cap = math.asinh(-3.0 * math.log(S_FLOOR))
@@ -182,7 +182,7 @@ def build(ti: Any, n_grid: int, dim: int, material: str) -> SimpleNamespace:
 
     @ti.func
     def camclay_return(s, ljp):
-        """Principal stretches s (3) and log_Jp -> (s_new, log_Jp_new, yielded) (MODEL.md 4)."""
+        """Principal stretches s (3) and log_Jp -> (s_new, log_Jp_new, yielded) (docs/model.md §4)."""
         eps = ti.Vector([ti.log(ti.max(s[0], s_floor)), ti.log(ti.max(s[1], s_floor)),
                          ti.log(ti.max(s[2], s_floor))])
         tr = eps[0] + eps[1] + eps[2]

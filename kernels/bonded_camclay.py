@@ -3,12 +3,12 @@
 The weak layer of a snowpack is strong while its bonds hold and collapses once
 they break (Gaume et al. 2018: "cohesion loss coupled with volumetric
 collapse"). Gaume's Cam-Clay (:mod:`mpm_warp.kernels.camclay`) has one
-hardening variable and cannot do both (MODEL.md 3b), so the weak layer carries
+hardening variable and cannot do both (docs/model.md §3b), so the weak layer carries
 a bonded part in its yield ellipse that decays with the plastic work done, as in
 structured / destructuring Cam-Clay (Rouainia and Muir Wood 2000; Liu and
-Carter 2002). Stresses are Kirchhoff (Pa), compression positive (MODEL.md 1):
+Carter 2002). Stresses are Kirchhoff (Pa), compression positive (docs/model.md §1):
 
-    y(p, q)  = (1 + 2 beta_e) q^2 + M^2 (p + beta_e p0)(p - p0)   (<= 0; MODEL.md 2)
+    y(p, q)  = (1 + 2 beta_e) q^2 + M^2 (p + beta_e p0)(p - p0)   (<= 0; docs/model.md §2)
     p0       = p0_int(log_Jp) + b p_bond                          (consolidation, Pa)
     beta_e   = beta b                                             (cohesion ratio)
     p0_int   = max(K sinh(xi max(-log_Jp, 0)), p0_floor)          (intrinsic: camclay_p0)
@@ -51,7 +51,7 @@ comes after the step (a difference of the order of one step's increment).
 ``kappa_s`` from a fracture energy or a softening displacement:
 :mod:`mpm_warp.scenes.weak_layer.calibration`.
 
-Return mapping (MODEL.md 4, SI Note 1), fully implicit. The discrete flow rule
+Return mapping (docs/model.md §4, SI Note 1), fully implicit. The discrete flow rule
 ``eps_tr - eps_new = dgamma dy/dtau`` is solved with the surface of the *new*
 state ``(log_Jp_new, kappa_new)``: the new ``(p, q)`` is the point of the
 ellipse of the new state closest to the trial in the energy metric

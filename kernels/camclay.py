@@ -1,6 +1,6 @@
 """Modified Cam-Clay with cohesion: yield, hardening and return mapping.
 
-Implements MODEL.md sections 2-4 (Gaume et al. 2018, Supplementary Note 1).
+Implements docs/model.md §2-4 (Gaume et al. 2018, Supplementary Note 1).
 Stresses are Kirchhoff, in Pa, compression positive:
 
     p = -K tr(eps),   q = sqrt(6) mu |dev eps|,   K = lam + 2 mu / 3
@@ -50,7 +50,7 @@ _MAX_ROOT_ITERATIONS = 100
 
 
 def initial_log_jp(p0_ini, K, xi):
-    """Initial hardening state for a consolidation pressure (MODEL.md section 3).
+    """Initial hardening state for a consolidation pressure (docs/model.md §3).
 
     Parameters
     ----------
@@ -73,7 +73,7 @@ def initial_log_jp(p0_ini, K, xi):
 def camclay_yield_func(T):
     """Build ``camclay_yield(p, q, p0, M, beta) -> T`` (Pa^2).
 
-    ``y = (1 + 2 beta) q^2 + M^2 (p + beta p0)(p - p0)`` (MODEL.md section 2);
+    ``y = (1 + 2 beta) q^2 + M^2 (p + beta p0)(p - p0)`` (docs/model.md §2);
     ``y <= 0`` inside the ellipse through ``p = -beta p0`` and ``p = p0``.
     """
 
@@ -88,7 +88,7 @@ def camclay_yield_func(T):
 def camclay_p0_func(T):
     """Build ``camclay_p0(log_jp, K, xi, p0_floor) -> T``: consolidation pressure (Pa).
 
-    ``p0 = max(K sinh(xi max(-log_jp, 0)), p0_floor)`` (MODEL.md section 3),
+    ``p0 = max(K sinh(xi max(-log_jp, 0)), p0_floor)`` (docs/model.md §3),
     capped at ``-3 K ln(SINGULAR_VALUE_FLOOR)`` (about 41.4 K) so it stays finite.
     ``sinh x`` of an argument up to 1/4 (most snow: ``xi |log_jp|`` of a few 1e-3) by its
     Taylor series to ``x^9`` (float32; ``x^15`` float64): the first omitted term is below
@@ -123,7 +123,7 @@ def camclay_pq_func(T):
     """Build ``camclay_pq(sig, mu, lam) -> (p, q)`` from singular values of ``F_E``.
 
     ``sig`` (vec3, dimensionless) is floored at ``SINGULAR_VALUE_FLOOR``;
-    returns ``p = -K tr(eps)`` and ``q = sqrt(6) mu |dev eps|`` (Pa, MODEL.md
+    returns ``p = -K tr(eps)`` and ``q = sqrt(6) mu |dev eps|`` (Pa, docs/model.md
     section 1), equal to ``-tr(tau)/3`` and ``sqrt(3/2)|dev tau|`` of the Hencky law.
     """
     v3 = vec3(T)
@@ -247,7 +247,7 @@ def camclay_return_func(T):
         trial (``y <= 0``) the input ``sig`` itself, bit for bit.
     log_jp_new : T
         ``log_jp + tr(eps_tr) - tr(eps_new)`` (hardening applied after the
-        projection, explicit in ``p0``; MODEL.md section 4).
+        projection, explicit in ``p0``; docs/model.md §4).
     yielded : int32
         1 if a projection happened, 0 otherwise.
 

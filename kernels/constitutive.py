@@ -2,7 +2,7 @@
 
 P2G (``kernels/p2g.py``) and the material-point driver (``mpm_warp/material_point.py``)
 both call :func:`constitutive_update_func`, so the driver is the engine's update bit
-for bit. Per particle and step (MODEL.md 1 and 4, SI Note 1):
+for bit. Per particle and step (docs/model.md §1 and 4, SI Note 1):
 
 1. trial state ``F_tr = (I + dt C) F_E``. The elastic state is stored as the
    displacement gradient ``H = F_E - I`` and the trial is formed as

@@ -26,7 +26,7 @@ def energy_kernel(dim, T):
     """Kinetic ``0.5 m |v|^2`` and elastic ``V0 psi(F_E)`` energy (J; J/m in plane strain) of one group.
 
     Accumulates into ``out[0]`` (kinetic) and ``out[1]`` (elastic), float64.
-    ``psi = mu |eps|^2 + lam/2 tr(eps)^2`` (Hencky, MODEL.md 1).
+    ``psi = mu |eps|^2 + lam/2 tr(eps)^2`` (Hencky, docs/model.md §1).
     """
     V = vec(dim, T)
     M = mat(dim, T)

@@ -1,4 +1,4 @@
-"""Hencky St Venant-Kirchhoff elasticity in principal form (MODEL.md section 1).
+"""Hencky St Venant-Kirchhoff elasticity in principal form (docs/model.md §1).
 
 With the SVD ``F_E = U diag(s) V^T`` (``wp.svd3``: ``U``, ``V`` rotations, ``s``
 sorted by decreasing magnitude, the last one carrying the sign of ``det F_E``)
@@ -58,7 +58,7 @@ def hencky_func(T):
     -------
     vec3
         Principal Kirchhoff stresses ``tau_i = 2 mu eps_i + lam tr(eps)`` (Pa),
-        ``eps_i = ln max(sig_i, s_floor)`` (MODEL.md section 1), tension positive.
+        ``eps_i = ln max(sig_i, s_floor)`` (docs/model.md §1), tension positive.
     """
     v3 = vec3(T)
     clamp = clamp_singular_func(T)
@@ -79,7 +79,7 @@ def hencky_energy_func(T):
     """Build ``hencky_energy(sig, mu, lam, s_floor) -> T``.
 
     Returns the strain energy density ``psi = mu |eps|^2 + lam/2 tr(eps)^2``
-    (J/m^3 of reference volume, MODEL.md section 1) with the same floored
+    (J/m^3 of reference volume, docs/model.md §1) with the same floored
     strains ``eps_i = ln max(sig_i, s_floor)`` as :func:`hencky_func`, so that
     ``d psi / d eps_i = tau_i``.
     """
@@ -99,7 +99,7 @@ def hencky_energy_func(T):
 @functools.cache
 def hencky_strain_func(T):
     """Build ``hencky_strain(eps, mu, lam) -> vec3``: principal Kirchhoff stresses ``2 mu eps_i + lam tr(eps)`` (Pa)
-    of principal Hencky strains ``eps`` (-) (MODEL.md section 1), the form :func:`hencky_func` takes after the log."""
+    of principal Hencky strains ``eps`` (-) (docs/model.md §1), the form :func:`hencky_func` takes after the log."""
     v3 = vec3(T)
 
     @wp.func

@@ -1,4 +1,4 @@
-"""Grid update: nodal momentum to velocity, gravity, walls (MODEL.md 5).
+"""Grid update: nodal momentum to velocity, gravity, walls (docs/model.md §5).
 
 Walls are planes ``(point, normal)`` with the normal pointing into the
 material. A node with signed distance ``phi = (x_i - p(t)) . n <= 1e-3 dx``

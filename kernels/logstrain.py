@@ -5,7 +5,7 @@ The elastic state is stored as the displacement gradient ``H = F_E - I`` (see
 with ``b = F F^T = I + X``, ``X = H + H^T + H H^T`` (formed from ``H`` directly,
 so a strain of 1e-6 keeps its float32 digits instead of drowning in the 1 of
 ``F``). The Kirchhoff stress of the Hencky St Venant-Kirchhoff model is then
-``tau = 2 mu eps + lam tr(eps) I`` (MODEL.md 1, written without the SVD:
+``tau = 2 mu eps + lam tr(eps) I`` (docs/model.md §1, written without the SVD:
 ``U diag(f(s)) U^T = f(U diag(s) U^T)`` for any isotropic ``f``).
 
 For ``X`` small the matrix logarithm is its series

@@ -4,7 +4,7 @@ One launch per particle group (a block of one material). Per particle, in
 physical order:
 
 1. trial elastic state ``H_tr = H + L + L H``, ``L = dt C`` (``F_tr = (I + dt C) F_E``,
-   MODEL.md 4) and the material's constitutive update, which returns the new
+   docs/model.md §4) and the material's constitutive update, which returns the new
    elastic state and the Kirchhoff stress ``tau`` (``kernels/constitutive.py``);
    In plane strain a plastic particle also updates its out-of-plane elastic stretch ``hzz``
    (indexed as ``log_jp``); an elastic one has ``F_E,zz = 1`` and stores none;

@@ -1,6 +1,6 @@
 """Device-side time control: the step size and the clock live on the device.
 
-The automatic step is ``dt = cfl dx / (c_p + |v|_max)`` (MODEL.md 5) with
+The automatic step is ``dt = cfl dx / (c_p + |v|_max)`` (docs/model.md §5) with
 ``|v|_max`` the largest nodal speed of the previous step, capped by ``dt_max``
 and by the time left to the end of the current frame, so frames end exactly
 on their times without any host read-back inside the substep loop.

@@ -6,7 +6,7 @@ gradient ``L = dt grad v`` (equivalently ``F_inc = I + L``): the trial is
 ``H_tr = H + L + L H`` and the update is
 :func:`mpm_warp.kernels.constitutive.constitutive_update_func`, the very
 function P2G calls, so a point driven by the ``dt C`` a particle saw follows that
-particle bit for bit. Used to test the constitutive update (VALIDATION.md,
+particle bit for bit. Used to test the constitutive update (docs/validation.md,
 "Cam-Clay single material point") and to calibrate a material before a big run.
 
 Mixed control: on chosen axes the normal Cauchy stress is prescribed instead of
@@ -16,7 +16,7 @@ those axes are then unknowns, solved at every increment by Newton iterations
 with the elastic tangent (``d sigma_aa / d L_bb = lam + 2 mu delta_ab``), repeating
 the update from the increment's start state.
 
-Stresses: ``p``, ``q`` Kirchhoff, compression positive (MODEL.md 1); ``stress``
+Stresses: ``p``, ``q`` Kirchhoff, compression positive (docs/model.md §1); ``stress``
 Cauchy ``tau / J_E``, tension positive.
 """
 
@@ -276,7 +276,7 @@ def isotropic_compression(volumetric_strain: float, n_increments: int, **materia
     Applies ``n_increments`` equal increments ``F_inc = exp(-volumetric_strain /
     (3 n)) I``, so that ``-ln det F = volumetric_strain`` at the end
     (compression positive). On the cap (``q = 0``) the theory gives
-    ``1 - J_P = 1 - exp(-asinh(p/K)/xi)`` (MODEL.md section 6, SI Note 3).
+    ``1 - J_P = 1 - exp(-asinh(p/K)/xi)`` (docs/model.md §6, SI Note 3).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Constitutive models: elastic snow/ice, cohesive Cam-Clay snow and the bonded weak layer (MODEL.md 1-3b).
+"""Constitutive models: elastic snow/ice, cohesive Cam-Clay snow and the bonded weak layer (docs/model.md §1-3b).
 
 Materials are plain dataclasses; the engine turns them into kernel arguments.
 Every model uses St Venant-Kirchhoff elasticity in Hencky strain.
@@ -22,7 +22,7 @@ def lame_parameters(E, nu):
     """Shear modulus, first Lame parameter and bulk modulus ``(mu, lam, K)`` (Pa) of ``E`` (Pa) and ``nu`` (-).
 
     ``mu = E / (2 (1 + nu))``, ``lam = E nu / ((1 + nu)(1 - 2 nu))``, ``K = lam + 2 mu / 3``
-    (MODEL.md 1). Floats or NumPy arrays; the one home of these formulas (a material's
+    (docs/model.md §1). Floats or NumPy arrays; the one home of these formulas (a material's
     :attr:`Elastic.mu`, :attr:`Elastic.lam` and :attr:`Elastic.bulk` call it).
     """
     mu = E / (2.0 * (1.0 + nu))
@@ -35,7 +35,7 @@ def hardening_collapse(p, K: float, xi: float, p0_ini: float = 0.0):
 
     ``1 - exp(log_Jp(p) - log_Jp(p0_ini))`` with the hardening state of a consolidation
     pressure, ``log_Jp(p0) = -asinh(p0 / K) / xi`` (:func:`mpm_warp.kernels.camclay.initial_log_jp`,
-    MODEL.md 3 and 6), i.e. ``1 - exp(-(asinh(p/K) - asinh(p0_ini/K)) / xi)``; zero where
+    docs/model.md §3 and 6), i.e. ``1 - exp(-(asinh(p/K) - asinh(p0_ini/K)) / xi)``; zero where
     ``p <= p0_ini`` (the cap does not move below its consolidation pressure). ``p``, ``p0_ini``
     and ``K`` in Pa; ``p`` a float or an array.
     """
@@ -99,7 +99,7 @@ class Elastic:
 
     @property
     def rayleigh_speed(self) -> float:
-        """Rayleigh wave speed c_R ~ c_s (0.862 + 1.14 nu) / (1 + nu) (m/s), MODEL.md 7."""
+        """Rayleigh wave speed c_R ~ c_s (0.862 + 1.14 nu) / (1 + nu) (m/s), docs/model.md §7."""
         return self.s_wave_speed * (0.862 + 1.14 * self.nu) / (1.0 + self.nu)
 
     def to_dict(self) -> dict:
@@ -109,7 +109,7 @@ class Elastic:
 
 @dataclass(frozen=True)
 class CamClaySnow(Elastic):
-    """Cohesive modified Cam-Clay snow with hardening and softening (MODEL.md 2-3).
+    """Cohesive modified Cam-Clay snow with hardening and softening (docs/model.md §2-3).
 
     Parameters
     ----------
@@ -125,7 +125,7 @@ class CamClaySnow(Elastic):
         Initial consolidation pressure (Pa), >= 0; sets ``log_Jp(0) = -asinh(p0_ini/K)/xi``.
     p0_floor_ratio : float
         Floor of p0 relative to K (-), keeps the return defined for fully
-        softened material; default 1e-5 (MODEL.md 3).
+        softened material; default 1e-5 (docs/model.md §3).
     """
 
     M: float = 1.0
@@ -153,7 +153,7 @@ class CamClaySnow(Elastic):
 
     @property
     def initial_log_jp(self) -> float:
-        """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (MODEL.md 3; :func:`mpm_warp.kernels.camclay.initial_log_jp`)."""
+        """``log_Jp(0) = -asinh(p0_ini / K) / xi`` (docs/model.md §3; :func:`.kernels.camclay.initial_log_jp`)."""
         return initial_log_jp(self.p0_ini, self.bulk, self.xi)
 
     def collapse_at(self, p) -> float:
@@ -166,11 +166,11 @@ class CamClaySnow(Elastic):
 class BondedCamClay(Elastic):
     """Bonded (structured) Cam-Clay weak layer: strength lost over a set plastic work, then collapse.
 
-    The yield ellipse of MODEL.md 2 with ``p0 = p0_int(log_Jp) + b p_bond`` and
+    The yield ellipse of docs/model.md §2 with ``p0 = p0_int(log_Jp) + b p_bond`` and
     cohesion ratio ``beta b``, ``b = max(0, 1 - kappa / kappa_s)`` the bond,
     ``kappa`` the plastic work done per unit volume (J/m^3, layer-column mean: the
     layer is debonded once it dissipated ``kappa_s D_wl`` per unit area) and ``p0_int =
-    K sinh(xi max(-log_Jp, 0))`` the intrinsic hardening (MODEL.md 3b;
+    K sinh(xi max(-log_Jp, 0))`` the intrinsic hardening (docs/model.md §3b;
     :mod:`mpm_warp.kernels.bonded_camclay`). Kernel state: ``(log_jp, kappa)``.
     Build it from field measurements with :func:`mpm_warp.scenes.weak_layer.calibration.weak_layer_material`.
 
@@ -188,7 +188,7 @@ class BondedCamClay(Elastic):
         Initial intrinsic consolidation pressure (Pa), >= 0 (0: a loose skeleton
         that collapses once debonded); ``log_Jp(0) = -asinh(p0_int_ini / K) / xi``.
     p0_floor_ratio : float
-        Floor of ``p0_int`` relative to K (-), in (0, 1e-2]; default 1e-5 (MODEL.md 3).
+        Floor of ``p0_int`` relative to K (-), in (0, 1e-2]; default 1e-5 (docs/model.md §3).
     p_bond : float
         Bonded part of the consolidation pressure of the intact layer (Pa), >= 0.
     kappa_s : float
@@ -225,7 +225,7 @@ class BondedCamClay(Elastic):
 
     @property
     def initial_log_jp(self) -> float:
-        """``log_Jp(0) = -asinh(p0_int_ini / K) / xi`` (MODEL.md 3)."""
+        """``log_Jp(0) = -asinh(p0_int_ini / K) / xi`` (docs/model.md §3)."""
         return initial_log_jp(self.p0_int_ini, self.bulk, self.xi)
 
     @property

@@ -1,4 +1,4 @@
-"""Hencky St Venant-Kirchhoff stress in NumPy: the host mirror of ``kernels/elasticity.py`` (MODEL.md 1).
+"""Hencky St Venant-Kirchhoff stress in NumPy: the host mirror of ``kernels/elasticity.py`` (docs/model.md §1).
 
 The device computes the same stress in :func:`mpm_warp.kernels.elasticity.hencky_func` (P2G) and
 :func:`mpm_warp.kernels.diagnostics.stress_kernel` (the ``stress`` output field); this module is the

@@ -1,4 +1,4 @@
-"""Walls: planes that constrain grid velocities (MODEL.md 5).
+"""Walls: planes that constrain grid velocities (docs/model.md §5).
 
 A :class:`Wall` is a plane through ``point`` with ``normal`` pointing into the
 material. Kinds: ``"sticky"`` (no relative motion), ``"slip"`` (no normal

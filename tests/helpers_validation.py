@@ -1,4 +1,4 @@
-"""Shared helpers of the elastic and wall validation tests (VALIDATION.md).
+"""Shared helpers of the elastic and wall validation tests (docs/validation.md).
 
 Set-ups with closed-form answers (a quasi-1D fixed-free bar, a block on a
 floor), measurements (centre-of-mass velocity, zero crossings, fitted orders)

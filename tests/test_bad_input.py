@@ -1,4 +1,4 @@
-"""Bad input (VALIDATION.md "Stability and extreme inputs", STYLE.md 4 and 9).
+"""Bad input (docs/validation.md "Stability and extreme inputs").
 
 Malformed scenario files, out-of-range values and bad ``--set`` overrides
 must fail with :class:`mpm_warp.ScenarioError` or :class:`mpm_warp.InvalidArgument`

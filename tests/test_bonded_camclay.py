@@ -93,7 +93,7 @@ def run_return(sig, ljp, kap, c, dtype):
 
 
 def pq_np(sig, mu, lam):
-    """Reference p, q (Pa) and dev eps from singular values, float64 (MODEL.md section 1)."""
+    """Reference p, q (Pa) and dev eps from singular values, float64 (docs/model.md §1)."""
     eps = np.log(np.maximum(np.asarray(sig, np.float64), SINGULAR_VALUE_FLOOR))
     tr = eps.sum(axis=-1)
     dev = eps - tr[..., None] / 3.0

@@ -1,4 +1,4 @@
-"""Cam-Clay single material point (VALIDATION.md): return mapping and driver.
+"""Cam-Clay single material point (docs/validation.md): return mapping and driver.
 
 Tolerances (calibrated on the first runs, then fixed). The returned state is
 stored as singular values ``sig_new = exp(eps_new)``; recomputing ``p, q``
@@ -91,7 +91,7 @@ def run_return(sig, ljp, cases, dtype):
 
 
 def pq_np(sig, mu, lam):
-    """Reference p, q (Pa) from singular values, float64 (MODEL.md section 1)."""
+    """Reference p, q (Pa) from singular values, float64 (docs/model.md §1)."""
     eps = np.log(np.maximum(np.asarray(sig, np.float64), SINGULAR_VALUE_FLOOR))
     tr = eps.sum(axis=-1)
     dev = eps - tr[..., None] / 3.0
@@ -322,7 +322,7 @@ ISO = dict(E=1e6, nu=0.3, M=1.0, beta=0.3, xi=0.05)
 @pytest.mark.parametrize("dtype", list(TYPES))
 @pytest.mark.parametrize("p0_ini", [0.0, 1.5e3])
 def test_isotropic_compression_follows_hardening_rule(dtype, p0_ini):
-    """1 - J_P = 1 - exp(-(asinh(p/K) - asinh(p0_ini/K))/xi) (MODEL.md section 6).
+    """1 - J_P = 1 - exp(-(asinh(p/K) - asinh(p0_ini/K))/xi) (docs/model.md §6).
 
     Explicit hardening lags one increment (the return uses p0 of the previous
     log_Jp), so the relation has a first-order error ~ 0.95/n: 1e-3 needs

@@ -71,7 +71,7 @@ def test_drained_triaxial_reaches_the_critical_state():
 
     Cauchy stresses: the drained path is ``q = 3 (p - s_c)``; the apex of the
     cohesive ellipse has ``q / p = k = M (1 + beta) / ((1 - beta) sqrt(1 + 2 beta))``
-    (MODEL.md 2), so the path ends at ``p = 3 s_c / (3 - k)``, ``q = k p``, where the
+    (docs/model.md §2), so the path ends at ``p = 3 s_c / (3 - k)``, ``q = k p``, where the
     plastic volume stops changing. Measured after 100 % axial strain: p and q/p
     within 7e-7 (0.5 % short after 30 %: the approach is asymptotic).
     """

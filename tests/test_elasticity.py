@@ -1,4 +1,4 @@
-"""Hencky St Venant-Kirchhoff elasticity (MODEL.md section 1).
+"""Hencky St Venant-Kirchhoff elasticity (docs/model.md §1).
 
 Tolerances: principal stresses and energies agree with float64 NumPy to a
 relative ``16 u (1 + |eps|)`` of the stress scale ``(2 mu + 3 lam)``

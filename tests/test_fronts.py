@@ -14,7 +14,7 @@ from mpm_warp.scenes.snow import Settle
 
 # ----------------------------------------------------------------------------- references
 def test_heierli_reproduces_model_example():
-    # MODEL.md 6: E = 5 MPa, h = 0.5 m, h_f = 2 mm, rho = 200 gives about 34 m/s and 1.6 m
+    # docs/model.md §6: E = 5 MPa, h = 0.5 m, h_f = 2 mm, rho = 200 gives about 34 m/s and 1.6 m
     assert references.heierli_speed(5e6, 0.5, 200.0, 0.002) == pytest.approx(33.6, abs=0.5)
     assert references.heierli_touchdown(5e6, 0.5, 200.0, 0.002) == pytest.approx(1.59, abs=0.05)
     # c^4 h_f = const and l^4 / h_f = const
@@ -24,7 +24,7 @@ def test_heierli_reproduces_model_example():
 
 
 def test_rayleigh_speed_model_example():
-    # MODEL.md 7: E = 5 MPa, nu = 0.3, rho = 250: c_s 88, c_R 81 m/s
+    # docs/model.md §7: E = 5 MPa, nu = 0.3, rho = 250: c_s 88, c_R 81 m/s
     assert Elastic(5e6, 0.3, 250.0).rayleigh_speed == pytest.approx(81.2, abs=0.3)
 
 

@@ -1,4 +1,4 @@
-"""Stability and extreme inputs (VALIDATION.md "Stability and extreme inputs").
+"""Stability and extreme inputs (docs/validation.md "Stability and extreme inputs").
 
 Every scene here is tiny (tens to a few thousand particles, plane strain one
 or two cells thick) and runs on the CPU. Measured numbers are quoted in the

@@ -1,4 +1,4 @@
-"""Kernel and transfer identities (VALIDATION.md, exact)."""
+"""Kernel and transfer identities (docs/validation.md, exact)."""
 
 import numpy as np
 import pytest

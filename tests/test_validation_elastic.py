@@ -1,7 +1,7 @@
-"""Elastic validation against closed forms (VALIDATION.md, "Elastic").
+"""Elastic validation against closed forms (docs/validation.md, "Elastic").
 
 Measured on the CPU (errors relative to the closed form; tolerances from
-VALIDATION.md, fixed after the first runs):
+docs/validation.md, fixed after the first runs):
 
 - axial bar, fixed-free, mode 1 (L 25, E 100, rho 1, nu 0, v0 0.1), float32:
   period error +0.72 % at dx = 1 (25 cells) and +0.35 % at dx = 0.5 (50 cells),
@@ -34,7 +34,7 @@ from helpers_validation import (
 import mpm_warp as mw
 from mpm_warp.stress import cauchy_stress
 
-#: tolerances (VALIDATION.md)
+#: tolerances (docs/validation.md)
 BAR_PERIOD_TOL = 0.01
 P_WAVE_TOL = 0.02
 
@@ -161,7 +161,7 @@ def test_column_self_weight_stress():
           f"(order {p_all:.2f}); wall-cell max {[r['wall_cell_max'] for r in res]}")
     assert interior[-1] < 0.005
     assert all(b < a for a, b in zip(interior, interior[1:], strict=False))
-    assert 0.8 < p_in < 2.5  # VALIDATION.md: order 1-2
+    assert 0.8 < p_in < 2.5  # docs/validation.md: order 1-2
     # whole column, boundary layer included: still converging, at the boundary-layer rate
     assert all(b < a for a, b in zip(overall, overall[1:], strict=False))
     assert p_all > 0.4

@@ -1,8 +1,8 @@
-"""Walls and friction (MODEL.md 5): slip, sticky, separable Coulomb contact, moving walls, reactions.
+"""Walls and friction (docs/model.md §5): slip, sticky, separable Coulomb contact, moving walls, reactions.
 
 A stiff elastic block (E 1e7 Pa, rho 1000 kg/m^3, nu 0.25, 20 x 10 cm, one
 2 cm cell thick in z between slip faces; c_p = 110 m/s) on a floor wall
-y = 0. Measured on the CPU in float32 (tolerances from VALIDATION.md and the
+y = 0. Measured on the CPU in float32 (tolerances from docs/validation.md and the
 brief, fixed after the first runs):
 
 - slip: tangential COM velocity kept to 4e-6 over 0.1 s, zero tangential

@@ -1,4 +1,4 @@
-"""Weak-layer collapse under a slab against the hardening rule (VALIDATION.md "Snow"; SI Note 3).
+"""Weak-layer collapse under a slab against the hardening rule (docs/validation.md "Snow"; SI Note 3).
 
 Set-up (:func:`weak_layer_column`)
 ----------------------------------
@@ -9,7 +9,7 @@ ramped from 0 over ``ramp`` seconds. The slab weight is the load; ``p0`` is
 varied through the slab density, as in the paper. The layer is laterally
 confined: the loading is uniaxial strain (oedometric), not isotropic.
 
-Closed form for this loading (derived here, MODEL.md 2-3)
+Closed form for this loading (derived here, docs/model.md §2-3)
 ---------------------------------------------------------
 Under uniaxial strain with ``xi`` small the state leaves the elastic line
 ``q/p = 2 mu/K`` and settles on the cap at the point where the flow direction
@@ -30,7 +30,7 @@ xi = 0.01, 0.04, 0.16 against 1/lambda_oed = 0.92187.
 The yield surface is in Kirchhoff stress, ``tau = J sigma`` with the total
 ``J = J_E J_P`` (relative to the start), while the slab weight fixes the
 Cauchy stress: ``sigma_v = W`` (weight per area above the point; the area is
-fixed by the side walls). So ``tau_v = J W`` and the hardening rule (MODEL.md 3)
+fixed by the side walls). So ``tau_v = J W`` and the hardening rule (docs/model.md §3)
 gives the collapse implicitly:
 
     1 - J_P = 1 - exp(-(asinh(p0 / K) - asinh(p0_ini / K)) / xi),
@@ -38,7 +38,7 @@ gives the collapse implicitly:
 
 (:func:`oedometric_collapse`, solved by bisection). Dropping ``J`` (using the
 Cauchy load) over-predicts the collapse by about the collapse itself (+10 % at
-1 - J_P = 0.09, +37 % at 0.32); the isotropic formula of MODEL.md 6 with
+1 - J_P = 0.09, +37 % at 0.32); the isotropic formula of docs/model.md §6 with
 ``p = W`` (``lambda_oed = 1``, ``q = 0``, no ``J``) by +19 % and +45 %.
 
 What each particle can assert exactly: ``log_Jp`` fixes ``p0`` through the

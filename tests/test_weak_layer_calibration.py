@@ -159,7 +159,7 @@ def test_collapse_after_shear_and_after_isotropic_crushing_follows_the_law(layer
     c_shear = r["collapse"][-1]
     print(f"after shear: collapse {c_shear:.5f}, law {float(collapse_law(mat, p0)):.5f}")
     assert abs(c_shear - float(collapse_law(mat, p0))) < 1e-2
-    assert c_shear > layer.h_c / layer.D_wl  # sheared: p0 above the oedometric one (MODEL.md 3b)
+    assert c_shear > layer.h_c / layer.D_wl  # sheared: p0 above the oedometric one (docs/model.md §3b)
     # isotropic compression beyond the intact strength: the bond breaks by compaction, then the intrinsic law
     e_end = -np.linspace(0.0, 0.5, 1001)[1:]
     iso = drive_layer(mat, np.exp(e_end / 3.0)[:, None, None] * np.eye(3))
@@ -200,7 +200,7 @@ def test_derived_predictions_and_summary(layer):
     a_c = math.sqrt(2 * 1000.0 * 5e6 / (1 - 0.09) * 0.02 / (mat.mu * 250.0 * 9.81))
     assert abs(layer.critical_cut - a_c) < 1e-12 and 0.15 < a_c < 0.6
     assert critical_cut_length_formula(**layer.critical_cut_inputs) == layer.critical_cut
-    c, l_td = heierli_anticrack(5e6, 0.5, 200.0, 2e-3)  # the example of MODEL.md 6: about 34 m/s and 1.6 m
+    c, l_td = heierli_anticrack(5e6, 0.5, 200.0, 2e-3)  # the example of docs/model.md §6: about 34 m/s and 1.6 m
     assert abs(c - 33.6) < 0.05 and abs(l_td - 1.58) < 0.005
     assert layer.heierli_speed == heierli_anticrack(5e6, 0.5, 250.0, layer.h_c)[0]
     text = str(layer)

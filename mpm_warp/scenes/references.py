@@ -1,4 +1,4 @@
-"""Closed-form references of the snow experiments (MODEL.md 3b, 6-7), in SI units: one home for each formula.
+"""Closed-form references of the snow experiments (docs/model.md §3b, 6-7), in SI units: one home for each formula.
 
 - Heierli (2005), elastic slab on a collapsing layer, ``D_f = E h^3 / 12``: crack speed
   ``c = (g D_f / (2 h_f rho h))^(1/4)``, touchdown distance ``l = 2.331 (2 h_f D_f / (g rho h))^(1/4)``.

@@ -1,4 +1,4 @@
-"""Reference problems with known answers, run at a chosen resolution (VALIDATION.md).
+"""Reference problems with known answers, run at a chosen resolution (docs/validation.md).
 
 Each problem runs one case at a grid spacing ``dx`` (and CFL factor or fixed
 step, precision, device) and returns its error against the exact or closed-form

@@ -89,7 +89,7 @@ def bar_period(sc: Scenario, device: str | None = "cpu",
 def axial_bar(dx: float = 1.0, *, cfl: float = 0.4, dt: float | None = None, precision: str = "float32",
               device: str | None = None, n_threads: int | None = None, length: float = 25.0, E: float = 100.0,
               density: float = 1.0, v0: float = 0.1, dimension: int = 3) -> dict:
-    """Fixed-free axial bar, mode 1: period error (VALIDATION.md "Elastic").
+    """Fixed-free axial bar, mode 1: period error (docs/validation.md "Elastic").
 
     L = 25, E = 100, rho = 1, nu = 0, v0 = 0.1 by default: ``T = 4 L / c = 10 s``.
     One cell across between slip walls, sticky wall at x = 0.
@@ -167,7 +167,7 @@ def self_weight_column(dx: float = 1.0 / 16.0, *, cfl: float = 0.4, dt: float | 
                        precision: str = "float64", device: str | None = None, n_threads: int | None = None,
                        height: float = 1.0, E: float = 1.0e6, nu: float = 0.3, density: float = 250.0,
                        dimension: int = 3) -> dict:
-    """Column under self-weight with lateral rollers: ``sigma_yy(Y) = -rho g (H - Y)`` (VALIDATION.md).
+    """Column under self-weight with lateral rollers: ``sigma_yy(Y) = -rho g (H - Y)`` (docs/validation.md).
 
     Hencky Cauchy stress computed in numpy from ``F_E``, averaged over the last
     mode-1 period of the hold (:func:`column_scenario`), ``Y`` the particle's

@@ -76,7 +76,7 @@ def oedometric_state(mat: CamClaySnow, axial_strain: float, n: int = 20000, dtyp
     """Uniaxial-strain compaction of one material point with the engine's return (no grid).
 
     Compresses ``y`` by the logarithmic strain ``axial_strain`` in ``n`` equal
-    increments (material-point driver, MODEL.md 4); returns the final ``p, q,
+    increments (material-point driver, docs/model.md §4); returns the final ``p, q,
     p0`` (Kirchhoff, Pa), ``e = -(log_Jp - log_Jp(0))`` and ``tau_v = p + 2 q/3`` (Pa).
     """
     from ..material_point import drive_material_points
@@ -225,7 +225,7 @@ def weak_layer_collapse(dx: float = 1.0 / 256.0, *, cfl: float = 0.4, dt: float 
                         precision: str = "float64", device: str | None = None, n_threads: int | None = None,
                         xi: float = 0.04, rho_slab: float = 1200.0, p0_ini: float = 0.0,
                         D_wl: float = 1.0 / 32.0, h_slab: float = 1.0 / 16.0) -> dict:
-    """Weak-layer collapse under a slab against the hardening rule (VALIDATION.md "Snow"; SI Note 3).
+    """Weak-layer collapse under a slab against the hardening rule (docs/validation.md "Snow"; SI Note 3).
 
     :func:`weak_layer_column` (Cam-Clay layer E 0.2 MPa, nu 0.3, rho 150, M 1,
     beta 0.3 under an elastic slab E 1 MPa), run until settled by :func:`run_column`.

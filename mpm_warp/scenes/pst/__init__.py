@@ -1,4 +1,4 @@
-"""Propagation Saw Test (PST): parameters, builder, saw, crack-front tracking (MODEL.md 6).
+"""Propagation Saw Test (PST): parameters, builder, saw, crack-front tracking (docs/model.md §6).
 
 A column of length ``L``: elastic old snow (the substratum, ``D_sub``) bonded to the bed (a wall at
 ``y = 0``), the weak layer (``D_wl``, the bonded Cam-Clay of :mod:`mpm_warp.scenes.weak_layer`,

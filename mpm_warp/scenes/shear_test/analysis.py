@@ -48,7 +48,7 @@ def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
     2.13, 2.17, 2.26, 2.45 mm) because the last column to debond sits ever closer to an end. The collapse is
     given beside two laws: ``collapse_fraction_law`` (oedometric, the debonded layer under the slab at rest) and
     ``collapse_fraction_critical_state`` (the debonded, cohesionless layer at the critical state of its final
-    mean Kirchhoff pressure ``p_final``: ``p0 = 2 p``; a sheared layer compacts more, MODEL.md 3b). The
+    mean Kirchhoff pressure ``p_final``: ``p0 = 2 p``; a sheared layer compacts more, docs/model.md §3b). The
     calibrated layer's predictions (:meth:`ShearTestParams.references`) are copied in.
     """
     c = shear_curves(params, times, series)

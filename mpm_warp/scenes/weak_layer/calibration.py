@@ -91,7 +91,7 @@ _CALIBRATION_ACCEPT = 1e-2  # relative error accepted when the secant stalls on 
 def heierli_anticrack(slab_E: float, slab_thickness: float, slab_density: float, h_c: float) -> tuple[float, float]:
     """Heierli (2005) steady anticrack ``(speed, touchdown)`` (m/s, m) of a slab on a layer collapsing by ``h_c``
     (m): :func:`~mpm_warp.scenes.references.heierli_speed` and :func:`~mpm_warp.scenes.references.heierli_touchdown`.
-    Example of MODEL.md 6: 5 MPa, 0.5 m, 200 kg/m^3, 2 mm give 33.6 m/s and 1.58 m."""
+    Example of docs/model.md §6: 5 MPa, 0.5 m, 200 kg/m^3, 2 mm give 33.6 m/s and 1.58 m."""
     return (heierli_speed(slab_E, slab_thickness, slab_density, h_c),
             heierli_touchdown(slab_E, slab_thickness, slab_density, h_c))
 

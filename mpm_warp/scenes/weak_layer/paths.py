@@ -12,7 +12,7 @@ is loaded in the two tests that define its measured properties
   shear stress ``sigma_xy`` at first yield; then the bond softens and, once the
   bond cannot carry ``sigma_n`` any more, the layer collapses.
 
-Elastic states are exact at finite strain (Hencky, MODEL.md 1): uniaxial
+Elastic states are exact at finite strain (Hencky, docs/model.md §1): uniaxial
 strain has ``eps = (0, ln lambda, 0)``; simple shear ``eps = ln(F F^T)/2``,
 solved by Newton in ``(ln lambda, gamma)``. The yield test of a state is
 :func:`mpm_warp.validation.weak_layer.consolidation_pressure` (the ellipse
@@ -175,7 +175,7 @@ def collapse_law(mat: BondedCamClay, p0_int) -> np.ndarray:
     """Intrinsic hardening law: collapse ``1 - J_P/J_P(0) = 1 - exp(-(asinh(p0/K) - asinh(p0_int_ini/K))/xi)``.
 
     ``p0_int`` (Pa) is the intrinsic consolidation pressure of the final state
-    (MODEL.md 3, 6; the debonded layer: ``p0 = p0_int``).
+    (docs/model.md §3, 6; the debonded layer: ``p0 = p0_int``).
     """
     K = mat.bulk
     return 1.0 - np.exp(-(np.arcsinh(np.asarray(p0_int, dtype=np.float64) / K) - math.asinh(mat.p0_int_ini / K))
