@@ -15,6 +15,8 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal, Protocol, get_args, runtime_checkable
 
+import numpy as np
+
 from .checks import choice, finite_number, positive_int, vector
 from .errors import InvalidArgument
 from .materials import Elastic
@@ -76,6 +78,9 @@ class Block:
         Particles per cell and axis, 1-8 (2 gives 8 per cell in 3D, 4 in 2D).
     name : str
         Label of the block (its particle group).
+    halfspaces : tuple of (dim + 1,) float
+        Planes that also bound the block: ``(n_x, n_y[, n_z], c)`` keeps the lattice points with
+        ``n . x <= c`` (m); e.g. the slanted ends of a PST column with vertical faces. Empty: the box.
     """
 
     material: str
@@ -84,6 +89,14 @@ class Block:
     velocity: Any = None
     particles_per_cell: int = 2
     name: str = ""
+    halfspaces: tuple = ()
+
+    def inside(self, x):
+        """Mask (n,) of the points ``x`` (n, dim) (m) inside every one of :attr:`halfspaces`."""
+        keep = np.ones(len(x), dtype=bool)
+        for h in self.halfspaces:
+            keep &= np.asarray(x) @ np.asarray(h[:-1], dtype=float) <= float(h[-1])
+        return keep
 
 
 @dataclass(frozen=True)
@@ -199,6 +212,10 @@ class Scenario:
     scene : SceneParams or None
         Typed parameters of the snow scene this scenario was built from (None for plain blocks);
         the engine stores them (run files, checkpoints) and never reads them.
+    calibration : dict or None
+        What the scene's builder derived from its parameters, as plain JSON values (the PST's and the
+        shear test's weak-layer calibration: model parameters and predictions); stored with the scenario
+        so that monitors, resumes and post-processing read it instead of deriving it again.
     """
 
     name: str
@@ -211,6 +228,7 @@ class Scenario:
     precision: Precision = "float32"
     description: str = ""
     scene: SceneParams | None = None
+    calibration: dict | None = None
 
     def validate(self) -> Scenario:
         """Check every field before any kernel runs; return a normalised copy."""
@@ -239,6 +257,8 @@ class Scenario:
         outp = Output(tuple(dict.fromkeys(("x", *out.fields))), out.checkpoint_every, out.health_every,
                       out.on_inversion)
         choice("precision", self.precision, PRECISIONS)
+        if self.calibration is not None and not isinstance(self.calibration, dict):
+            raise InvalidArgument("calibration", self.calibration, "a dict of what the scene builder derived, or None")
         if self.scene is not None and not isinstance(self.scene, SceneParams):
             raise InvalidArgument("scene", self.scene, "typed scene parameters (e.g. mpm_warp.scenes.pst.PSTParams) "
                                   "or None; a scenario file's [scene] table is read by mpm_warp.loader")
@@ -267,6 +287,8 @@ class Scenario:
             d["blocks"].append(bd)
         if self.scene is not None:
             d["scene"] = {"kind": self.scene.kind, **self.scene.to_dict()}
+        if self.calibration is not None:
+            d["calibration"] = self.calibration
         return json.loads(json.dumps(d, default=list))
 
 
@@ -330,7 +352,13 @@ def _block(b: Block, i: int, mats: dict, dom: Domain) -> Block:
     ppc = positive_int(f"{w}.particles_per_cell", b.particles_per_cell, lo=1, hi=8)
     vel = b.velocity if callable(b.velocity) else vector(
         f"{w}.velocity", (0.0,) * dim if b.velocity is None else b.velocity, dim)
-    return Block(b.material, blo, bhi, vel, ppc, b.name or f"block{i}")
+    if isinstance(b.halfspaces, (str, bytes)) or not isinstance(b.halfspaces, (list, tuple)):
+        raise InvalidArgument(f"{w}.halfspaces", b.halfspaces, f"a list of planes [n_1, ..., n_{dim}, c]")
+    hs = tuple(vector(f"{w}.halfspaces[{k}]", h, dim + 1) for k, h in enumerate(b.halfspaces))
+    for k, h in enumerate(hs):
+        if all(c == 0.0 for c in h[:-1]):
+            raise InvalidArgument(f"{w}.halfspaces[{k}]", h, "a plane with a non-zero normal")
+    return Block(b.material, blo, bhi, vel, ppc, b.name or f"block{i}", hs)
 
 
 def _step_budget(tc: TimeControl, dx: float, mats: dict, blocks) -> None:

@@ -40,7 +40,7 @@ __all__ = ["load_scenario", "scenario_from_dict", "resolved_scenario", "scene_pa
 
 #: keys of a scenario file's top level
 TOP_LEVEL_KEYS = ("name", "description", "precision", "domain", "time", "materials", "blocks", "walls", "output",
-                  "scene")
+                  "scene", "calibration")
 #: sections a scene generates (a file with a scene may not give them)
 GENERATED_SECTIONS = ("domain", "materials", "blocks", "walls")
 
@@ -74,12 +74,24 @@ def from_table(cls, table, where: str, source: str = "scenario"):
         hint = hints[k]
         if isinstance(v, float) and math.isnan(v):
             raise InvalidArgument(f"{where}.{k}", v, "a number, not NaN")
+        item = _tuple_item(hint)
         if isinstance(hint, type) and dataclasses.is_dataclass(hint):
             v = from_table(hint, v, f"{where}.{k}", source)
+        elif item is not None:
+            v = tuple(from_table(item, t, f"{where}.{k}[{i}]", source)
+                      for i, t in enumerate(_table_list(v, f"{where}.{k}", source)))
         elif isinstance(v, list):
             v = tuple(v)
         kwargs[k] = v
     return cls(**kwargs)
+
+
+def _tuple_item(hint):
+    """The dataclass ``D`` of a ``tuple[D, ...]`` field (an array of tables), else None."""
+    args = typing.get_args(hint)
+    if typing.get_origin(hint) is tuple and args and isinstance(args[0], type) and dataclasses.is_dataclass(args[0]):
+        return args[0]
+    return None
 
 
 def material_from_table(d, where: str = "material", source: str = "scenario") -> Elastic:
@@ -106,7 +118,10 @@ def scene_params_from_dict(table: dict, source: str = "scenario"):
     if not isinstance(table, dict):
         raise ScenarioError(f"{source}: [scene] must be a table")
     st = scene_type(table.get("kind"), source)
-    params = from_table(st.params, {k: v for k, v in table.items() if k != "kind"}, "scene", source)
+    table = {k: v for k, v in table.items() if k != "kind"}
+    if st.upgrade is not None:
+        table = st.upgrade(copy.deepcopy(table))
+    params = from_table(st.params, table, "scene", source)
     return params.validate("scene")
 
 
@@ -143,6 +158,9 @@ def scenario_from_dict(raw: dict, source: str = "scenario") -> Scenario:
     """
     raw = copy.deepcopy(raw)
     check_keys(raw, TOP_LEVEL_KEYS, "", source)
+    if "calibration" in raw:
+        raise ScenarioError(f"{source}: [calibration] is written by a scene's builder (run files); set the scene's "
+                            "parameters in [scene]")
     table = raw.get("scene")
     if table is not None and not isinstance(table, dict):
         raise ScenarioError(f"{source}: [scene] must be a table")
@@ -174,10 +192,14 @@ def resolved_scenario(d: dict, source: str = "scenario") -> Scenario:
     """
     d = copy.deepcopy(d)
     table = d.pop("scene", None)
+    calibration = d.pop("calibration", None)
     check_keys(d, TOP_LEVEL_KEYS, "", source)
     sc = _plain(d, source)
     if table:
-        sc = dataclasses.replace(sc, scene=scene_params_from_dict(table, source))
+        params = scene_params_from_dict(table, source)
+        if calibration is None:  # a run file of an older release: derive what it did not store, once
+            calibration = scene_type(params.kind).build(params, sc.time).calibration
+        sc = dataclasses.replace(sc, scene=params, calibration=calibration)
     return sc.validate()
 
 

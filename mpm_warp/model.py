@@ -197,12 +197,17 @@ class Model:
         for b in blocks:
             mat = scenario.materials[b.material]
             x, vol = seed_block(b.lo, b.hi, self.dx, b.particles_per_cell)
+            keep = b.inside(x)
+            if not keep.any():
+                raise InvalidArgument(f"block {b.name!r}.halfspaces", b.halfspaces, "planes that leave some of the box")
+            x = x[keep] if b.halfspaces else x
             n = len(x)
             g = ParticleGroup(b.name, b.material, mat, start, start + n, vol, mat.density * vol,
                               pstart if mat.plastic else -1)
             if mat.model == "bonded_camclay":
-                g.columns = lattice_columns(lattice_counts(b.lo, b.hi, self.dx, b.particles_per_cell))
-                g.n_columns = int(g.columns.max()) + 1
+                cols = lattice_columns(lattice_counts(b.lo, b.hi, self.dx, b.particles_per_cell))
+                g.columns = cols[keep] if b.halfspaces else cols
+                g.n_columns = int(cols.max()) + 1
                 self.n_bonded += n
             if mat.plastic:
                 pstart += n

@@ -172,7 +172,7 @@ def _synthetic_pst(c=30.0, l_td=1.2, h=0.004, reverse=False, lead=0.0):
     deflects behind it (reaching the deflection threshold ``lead`` metres behind the damage)."""
     L, cut, bw, t0 = 6.0, 0.4, 0.02, 0.5
     scene = PSTParams(length=L, dx=0.005, settle=Settle(gravity_ramp=0.05, duration=0.1),
-                      saw=Saw(speed=1.0, cut_length=cut, from_end="left"), front=Front(bin=bw))
+                      saw=Saw(speed=1.0, cut_length=cut, cut_from="upslope"), front=Front(bin=bw))
     assert scene.saw_end == pytest.approx(t0)
     t = np.arange(0.0, 0.8, 0.002)
     sb = (np.arange(int(L / bw)) + 0.5) * bw
@@ -191,7 +191,7 @@ def _synthetic_pst(c=30.0, l_td=1.2, h=0.004, reverse=False, lead=0.0):
 
 def test_pst_summary_on_ideal_front():
     scene, t, series, sb, tb, td = _synthetic_pst()
-    out = pst_summary(scene, t, series, sb, tb, td)
+    out = pst_summary(scene, scene.calibrated(), t, series, sb, tb, td)
     assert out["damage_speed_mean"] == pytest.approx(30.0, rel=1e-3)
     assert out["deflection_speed_mean"] == pytest.approx(30.0, rel=1e-3)
     assert out["speed"] == out["damage_speed_mean"] and out["front_agreement"] == pytest.approx(1.0, rel=1e-3)
@@ -211,15 +211,15 @@ def test_pst_summary_on_ideal_front():
 
 def test_pst_summary_lagging_deflection_and_an_arrest():
     scene, t, series, sb, tb, td = _synthetic_pst(lead=0.5)
-    out = pst_summary(scene, t, series, sb, tb, td)
+    out = pst_summary(scene, scene.calibrated(), t, series, sb, tb, td)
     assert out["deflection_speed_mean"] == pytest.approx(30.0, rel=1e-3)   # a constant lag: the same speed
     tb2 = np.where(sb <= 1.5, tb, np.inf)                                   # arrested at 1.5 m
-    out2 = pst_summary(scene, t, series, sb, tb2, td)
+    out2 = pst_summary(scene, scene.calibrated(), t, series, sb, tb2, td)
     assert not out2["propagated"] and not out2["ran_to_end"]
     assert out2["damage_front_final"] == pytest.approx(1.5, abs=0.02) and math.isnan(out2["speed"])
 
 
 def test_pst_summary_flags_a_crack_started_elsewhere():
     scene, t, series, sb, tb, td = _synthetic_pst(c=150.0, reverse=True)
-    out = pst_summary(scene, t, series, sb, tb, td)
+    out = pst_summary(scene, scene.calibrated(), t, series, sb, tb, td)
     assert out["max_damage_lead"] > 4.0 and out["max_damage_lead_at"] > 5.0

@@ -67,7 +67,7 @@ def test_pst_width_gives_3d_column():
 @pytest.mark.parametrize("override, match", [
     ("scene.slab.E=-1e6", "scene.slab.E"),
     ("scene.weak_layer_thickness=0.01", "cells"),
-    ("scene.saw.from_end='middle'", "from_end"),
+    ("scene.saw.cut_from='middle'", "cut_from"),
     ("scene.saw.speed=2.0", r"scene.saw.speed.*2"),
     ("scene.saw.cut_length=30.0", "scene.saw.cut_length"),
     ("scene.front.deflection=1.5", "scene.front.deflection"),
@@ -88,10 +88,10 @@ def test_pst_generated_sections_are_not_accepted():
 
 def test_pst_scene_round_trips_through_the_run_file_dict():
     """The typed parameters survive Scenario.to_dict (run files, checkpoints): resume rebuilds the same scene."""
-    sc = load_scenario("pst_slope", ["scene.saw.from_end='right'", "scene.bed='separate'",
+    sc = load_scenario("pst_slope", ["scene.saw.cut_from='downslope'", "scene.bed='separate'",
                                      "scene.weak_layer.w_f=0.0", "scene.weak_layer.delta_s=0.002"])
     back = resolved_scenario(sc.to_dict())
-    assert back == sc and back.scene.saw.from_end == "right" and back.walls[0].kind == "separate"
+    assert back == sc and back.scene.saw.cut_from == "downslope" and back.walls[0].kind == "separate"
     assert back.materials["weak_layer"] == sc.materials["weak_layer"]
 
 

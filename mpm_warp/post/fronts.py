@@ -15,8 +15,9 @@ from ..loader import scene_params_from_dict
 from ..scenes.fronts import fit_window, steady_speed
 from ..scenes.pst import PSTParams
 from ..scenes.pst.analysis import MEAN_SPEED_DISTANCE, end_zone
+from ..scenes.weak_layer import CalibratedWeakLayer
 
-__all__ = ["scene_params", "front_name", "fit_front_speed", "front_speed", "front_and_saw_x"]
+__all__ = ["scene_params", "scene_calibration", "front_name", "fit_front_speed", "front_speed", "front_and_saw_x"]
 
 
 def scene_params(run: RunData):
@@ -28,6 +29,16 @@ def scene_params(run: RunData):
         return scene_params_from_dict({k: v for k, v in table.items() if k != "derived"}, run.path)
     except MPMError:                  # a file of another version: the generic analyses still work
         return None
+
+
+def scene_calibration(run: RunData, params=None):
+    """The weak layer's calibration a snow run stored with its scenario (:class:`~mpm_warp.scenes.weak_layer.
+    CalibratedWeakLayer`), read, never rerun; a run file of an older release, which did not store it, has it
+    derived from its parameters ``params`` once (None without them)."""
+    stored = ((run.scenario or {}).get("calibration") or {}).get("weak_layer")
+    if stored is not None:
+        return CalibratedWeakLayer.from_dict(stored)
+    return params.calibrated() if params is not None else None
 
 
 def front_name(run: RunData) -> str | None:

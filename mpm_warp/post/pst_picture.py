@@ -23,7 +23,7 @@ import numpy as np
 from ..io import RunData, read_run
 from ..scenes.pst import PSTParams
 from ..scenes.pst.analysis import end_zone
-from .fronts import scene_params
+from .fronts import scene_calibration, scene_params
 
 __all__ = ["pst_picture", "running_frame"]
 
@@ -77,9 +77,9 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     fr = run.frame(k)
     x = fr["x"].astype(float)
     collapse = 1.0 - np.exp(fr["log_jp"][wl].astype(float) - fr["log_jp_ref"][wl].astype(float))
-    h_c = params.calibrated().h_c
+    h_c = scene_calibration(run, params).h_c
     c_max = 1.25 * h_c / params.weak_layer_thickness
-    D, L, cut = float(params.slab_thickness), float(params.length), float(params.saw.cut_length)
+    D, L, cut = float(params.slab_depth), float(params.length), float(params.saw.cut_length)
     f = exaggeration if exaggeration is not None else 0.25 * D / h_c
     shown = ref + f * (x - ref)
     t = float(run.times[k])
@@ -114,7 +114,7 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     # ---------------------------------------------------------------- zoom on the layer at the front
     xf = float(to_x(front))
     lo, hi = sorted((float(to_x(max(front - 0.8, 0.0))), float(to_x(min(front + 0.3, L)))))
-    y0, y1 = params.substratum_thickness - 0.01, params.base_y + 0.03
+    y0, y1 = params.substratum_depth - 0.01, params.base_y + 0.03
     box = (x[:, 0] >= lo) & (x[:, 0] <= hi) & (x[:, 1] >= y0) & (x[:, 1] <= y1)
     az.scatter(x[box & grey, 0], x[box & grey, 1], s=2.0, c="0.72", lw=0, rasterized=True)
     zw = box[wl]

@@ -45,6 +45,9 @@ class SceneType:
         ``attach(sim) -> Monitor``.
     time_keys : tuple of str
         ``[time]`` keys the scene sets itself (a scenario file may not give them).
+    upgrade : callable or None
+        ``upgrade(table) -> table``: a ``[scene]`` table of an older release (a stored run file) in today's
+        keys, before it is read.
     """
 
     kind: str
@@ -53,3 +56,4 @@ class SceneType:
     build: Callable
     attach: Callable
     time_keys: tuple[str, ...] = ()
+    upgrade: Callable | None = None

@@ -27,7 +27,7 @@ SPEED_LIMIT_DISTANCE = 5.0
 
 def end_zone(params: PSTParams) -> float:
     """Length of the far end zone (m): one slab thickness (at least two bins), whose free edge unloads the layer."""
-    return max(float(params.slab_thickness), 2.0 * params.bin_width)
+    return max(float(params.slab_depth), 2.0 * params.bin_width)
 
 
 def _front(params: PSTParams, s, t_arrival, prefix: str) -> dict:
@@ -53,12 +53,14 @@ def _runaway(params: PSTParams, s, t_arrival) -> float:
     return float(saw[k[0]]) if len(k) else math.nan
 
 
-def pst_summary(params: PSTParams, times, series: dict, s_bins, t_damage, t_deflection) -> dict:
+def pst_summary(params: PSTParams, calibration, times, series: dict, s_bins, t_damage, t_deflection) -> dict:
     """Crack fronts, speeds, touchdown and collapse of a PST.
 
     Parameters
     ----------
     params : PSTParams
+    calibration : CalibratedWeakLayer
+        The weak layer's calibration (the scenario's stored one), for the references.
     times : array (n,)
         Frame times (s).
     series : dict
@@ -107,11 +109,10 @@ def pst_summary(params: PSTParams, times, series: dict, s_bins, t_damage, t_defl
     out["touchdown"] = float(np.median(td[steady])) if steady.any() else math.nan
     ch = np.asarray(series.get("collapse_height", [0.0]), dtype=float)
     out["collapse_height"] = float(ch[-1]) if len(ch) else 0.0
-    refs = params.references()
+    refs = params.references(calibration)
     out.update({k: float(v) for k, v in refs.items()})
-    slab = params.slab
+    slab, D = params.equivalent_slab(), params.slab_depth
     h = out["collapse_height"]
-    out["heierli_speed_run"] = heierli_speed(slab.E, params.slab_thickness, slab.density, h) if h > 0 else math.nan
-    out["heierli_touchdown_run"] = heierli_touchdown(slab.E, params.slab_thickness, slab.density, h) \
-        if h > 0 else math.nan
+    out["heierli_speed_run"] = heierli_speed(slab.E, D, slab.density, h) if h > 0 else math.nan
+    out["heierli_touchdown_run"] = heierli_touchdown(slab.E, D, slab.density, h) if h > 0 else math.nan
     return out

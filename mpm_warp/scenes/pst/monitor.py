@@ -7,8 +7,9 @@ import warp as wp
 
 from ..fronts import front_from_arrival, touchdown_distance
 from ..series import SeriesMonitor, entries_below
-from ..weak_layer import ReferenceField, WeakLayerTracker, bin_median
+from ..weak_layer import ReferenceField, WeakLayerTracker, bin_median, stored_calibration
 from .analysis import end_zone, pst_summary
+from .build import layer_names
 from .kernels import deflection_kernel
 from .params import PSTParams
 
@@ -45,14 +46,15 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         self.params = p
         self.sim = sim
         T = sim.model.T
-        left = p.saw.from_end == "left"
+        left = p.cut_at_origin
         saw = (p.saw_start, p.saw.speed, p.saw.cut_length, 0.0 if left else float(p.length), 1.0 if left else -1.0)
         self.weak = WeakLayerTracker(sim, "weak_layer", p.saw_start, saw)
-        self.h_c = p.calibrated().h_c
+        self.calibration = stored_calibration(sim.scenario)
+        self.h_c = self.calibration.h_c
         self.s_weak = p.distance_from_cut_end(self.weak.group.x0[:, 0])
         self.interior = self.s_weak < p.length - end_zone(p)   # the collapse height's particles: not the far end
-        # the slab base: its lowest lattice row (all of it in z for the fronts)
-        self.slab = sim.group_state("slab")
+        # the slab base: the lowest lattice row of the slab's bottom layer (all of it in z for the fronts)
+        self.slab = sim.group_state(layer_names("slab", len(p.slab_stack()))[-1])
         x0 = self.slab.x0
         base = np.nonzero(x0[:, 1] <= x0[:, 1].min() + 1e-6)[0]
         self.base_index = base
@@ -122,7 +124,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
     def result(self) -> dict:
         """Scene results from the series and arrival times so far (:func:`.analysis.pst_summary`)."""
         times, series = self.series_arrays()
-        return pst_summary(self.params, times, series, self.bin_centres(), self.damage_arrival(),
+        return pst_summary(self.params, self.calibration, times, series, self.bin_centres(), self.damage_arrival(),
                            self.deflection_arrival())
 
     # ------------------------------------------------------------------ queries

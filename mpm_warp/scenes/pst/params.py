@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import asdict, dataclass, field
 from typing import ClassVar, Literal
@@ -9,6 +10,7 @@ from typing import ClassVar, Literal
 import numpy as np
 
 from ...checks import check_choices, finite_number, positive_int
+from ...errors import InvalidArgument
 from ...walls import WallKind
 from ..references import heierli_speed, heierli_touchdown
 from ..snow import (
@@ -18,11 +20,16 @@ from ..snow import (
     check_plane_strain,
     check_weak_layer_cells,
     oedometric_pressure,
-    slab_normal_stress,
 )
+from ..snowpack import SnowLayer, check_stack, equivalent_slab, stack_normal_stress, stack_thickness
 from ..weak_layer import CalibratedWeakLayer, WeakLayer
 
-__all__ = ["Saw", "Front", "PSTParams"]
+__all__ = ["Saw", "Front", "PSTParams", "ColumnEnds", "CutFrom", "upgrade_table"]
+
+#: where the saw starts: the column's upslope or downslope end (on flat ground "upslope" is the end x = 0)
+CutFrom = Literal["upslope", "downslope"]
+#: the column's end faces: normal to the slope (European practice) or vertical (the North American standard)
+ColumnEnds = Literal["slope_normal", "vertical"]
 
 
 @dataclass(frozen=True)
@@ -37,14 +44,16 @@ class Saw:
     speed : float
         Blade speed (m/s), in (0, 1]: a saw is slow against the crack (field saws: 0.1-0.5 m/s).
     cut_length : float
-        Length of the cut (m), in [0, length]: where the blade stops.
-    from_end : {"left", "right"}
-        The end it starts from: "left" (x = 0, the upslope end on a slope) or "right" (x = L).
+        Length of the cut (m), in [0, length], along the weak layer from the end it starts at: where the
+        blade stops.
+    cut_from : {"upslope", "downslope"}
+        The end of the column it starts from. ``x`` runs downslope, so on a slope of positive angle the
+        upslope end is ``x = 0``; on flat ground "upslope" names the end ``x = 0``.
     """
 
     speed: float = 1.0
     cut_length: float = 0.6
-    from_end: Literal["left", "right"] = "left"
+    cut_from: CutFrom = "upslope"
 
 
 @dataclass(frozen=True)
@@ -88,7 +97,11 @@ class PSTParams:
     substratum_thickness : float
         Elastic old snow under the weak layer (m), >= 2 dx: the layer shares no grid node with the bed.
     slope_angle : float
-        Slope (deg), in [-60, 60]: gravity ``g (sin, -cos)``.
+        Slope (deg), in [-60, 60]: gravity ``g (sin, -cos)`` (downslope is +x for a positive angle).
+    column_ends : {"slope_normal", "vertical"}
+        The column's end faces: normal to the slope (European practice, the default) or vertical (the North
+        American standard; Birkeland et al. 2025). Vertical ends lean upslope with height by ``tan(slope)``;
+        the column spans ``[0, length]`` at the weak layer's mid-height either way.
     width : float
         Column width (m); 0 = plane strain (quantities per metre of depth in true 2D).
     plane_strain : {"2d", "slab"}
@@ -104,9 +117,13 @@ class PSTParams:
     marker_spacing : float
         Spacing of the slab-base markers along the column (m), > 0.
     slab, substratum, weak_layer, settle, saw, front
-        The parts (:class:`~mpm_warp.scenes.snow.Slab` twice: the slab and the old snow under the
-        weak layer; :class:`~mpm_warp.scenes.weak_layer.WeakLayer`, :class:`~mpm_warp.scenes.snow.Settle`,
-        :class:`Saw`, :class:`Front`).
+        The parts (:class:`~mpm_warp.scenes.snow.Slab` twice: a homogeneous slab of ``slab_thickness`` and
+        the old snow of ``substratum_thickness`` under the weak layer; :class:`~mpm_warp.scenes.weak_layer.
+        WeakLayer`, :class:`~mpm_warp.scenes.snow.Settle`, :class:`Saw`, :class:`Front`).
+    slab_layers, substratum_layers : tuple of SnowLayer
+        A layered slab or substratum, top to bottom (:class:`~mpm_warp.scenes.snowpack.SnowLayer`; an
+        omitted E comes from the density). Given, they replace ``slab``/``slab_thickness`` (or
+        ``substratum``/``substratum_thickness``), which must then keep their defaults.
     """
 
     kind: ClassVar[str] = "pst"
@@ -117,6 +134,7 @@ class PSTParams:
     weak_layer_thickness: float = 0.03
     substratum_thickness: float = 0.15
     slope_angle: float = 0.0
+    column_ends: ColumnEnds = "slope_normal"
     width: float = 0.0
     plane_strain: PlaneStrain = "2d"
     bed: WallKind = "sticky"
@@ -129,6 +147,8 @@ class PSTParams:
     settle: Settle = field(default_factory=Settle)
     saw: Saw = field(default_factory=Saw)
     front: Front = field(default_factory=Front)
+    slab_layers: tuple[SnowLayer, ...] = ()
+    substratum_layers: tuple[SnowLayer, ...] = ()
 
     def validate(self, where: str = "scene") -> PSTParams:
         """Check every value (InvalidArgument naming ``where.field``, the value and the range); return self."""
@@ -139,7 +159,10 @@ class PSTParams:
         finite_number(f"{where}.slab_thickness", self.slab_thickness, lo=0.0, lo_open=True)
         d_wl = finite_number(f"{where}.weak_layer_thickness", self.weak_layer_thickness, lo=0.0, lo_open=True)
         check_weak_layer_cells(d_wl, dx, where)
-        finite_number(f"{where}.substratum_thickness", self.substratum_thickness, lo=2.0 * dx)
+        finite_number(f"{where}.substratum_thickness", self.substratum_thickness, lo=0.0, lo_open=True)
+        for part in ("slab", "substratum"):
+            self._check_layers(part, where)
+        finite_number(f"{where}.substratum_thickness (of the layers)", self.substratum_depth, lo=2.0 * dx)
         finite_number(f"{where}.slope_angle", self.slope_angle, lo=-60.0, hi=60.0)
         finite_number(f"{where}.width", self.width, lo=0.0)
         check_plane_strain(self.plane_strain, self.width, where)
@@ -157,25 +180,85 @@ class PSTParams:
         finite_number(f"{where}.front.runaway_lead", self.front.runaway_lead, lo=0.0, lo_open=True)
         return self
 
+    def _check_layers(self, part: str, where: str) -> None:
+        """Check ``{part}_layers``; refuse them beside a ``{part}``/``{part}_thickness`` that is not the default."""
+        layers = getattr(self, f"{part}_layers")
+        if not layers:
+            return
+        check_stack(layers, f"{where}.{part}_layers")
+        defaults = type(self).__dataclass_fields__
+        for name in (part, f"{part}_thickness"):
+            d = defaults[name]
+            default = d.default_factory() if d.default_factory is not dataclasses.MISSING else d.default
+            if getattr(self, name) != default:
+                raise InvalidArgument(f"{where}.{name}", getattr(self, name),
+                                      f"left out when {where}.{part}_layers are given (the layers define the {part})")
+
     def to_dict(self) -> dict:
         """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back)."""
         return asdict(self)
 
+    # ------------------------------------------------------------- the snowpack
+    def slab_stack(self) -> tuple[SnowLayer, ...]:
+        """The slab's layers, top to bottom (one layer of ``slab`` and ``slab_thickness`` unless layered)."""
+        return self.slab_layers or (SnowLayer(self.slab_thickness, self.slab.density, self.slab.E, self.slab.nu),)
+
+    def substratum_stack(self) -> tuple[SnowLayer, ...]:
+        """The substratum's layers, top to bottom."""
+        s = self.substratum
+        return self.substratum_layers or (SnowLayer(self.substratum_thickness, s.density, s.E, s.nu),)
+
+    @property
+    def layered(self) -> bool:
+        """Whether the slab has more than one layer."""
+        return len(self.slab_stack()) > 1
+
+    @property
+    def slab_depth(self) -> float:
+        """Slab thickness D (m): the weak layer's depth below the surface, bed-normal."""
+        return self.slab_thickness if not self.slab_layers else stack_thickness(self.slab_layers)
+
+    @property
+    def substratum_depth(self) -> float:
+        """Thickness of the substratum (m)."""
+        return self.substratum_thickness if not self.substratum_layers else stack_thickness(self.substratum_layers)
+
+    def equivalent_slab(self) -> Slab:
+        """The homogeneous slab of the same thickness, weight and bending stiffness (the slab itself unless
+        layered; :func:`~mpm_warp.scenes.snowpack.equivalent_slab`): the closed-form references use it."""
+        return self.slab if not self.slab_layers else equivalent_slab(self.slab_layers)
+
+    @property
+    def cut_at_origin(self) -> bool:
+        """Whether the saw starts at the end ``x = 0`` (the upslope end for a slope angle >= 0)."""
+        return (self.saw.cut_from == "upslope") == (self.slope_angle >= 0.0)
+
+    def end_shift(self, y: float) -> float:
+        """Shift along x (m) of the column's end faces at bed-normal height ``y`` (m) against the weak layer's
+        mid-height: 0 with slope-normal ends, ``-(y - y_wl) tan(slope)`` with vertical ones (they lean upslope)."""
+        if self.column_ends == "slope_normal":
+            return 0.0
+        y_wl = self.substratum_depth + 0.5 * self.weak_layer_thickness
+        return -(float(y) - y_wl) * math.tan(math.radians(self.slope_angle))
+
     # ------------------------------------------------------------- derived values
     @property
     def sigma_n(self) -> float:
-        """Bed-normal stress of the slab on the weak layer (Pa), ``rho g D cos(theta)``."""
-        return slab_normal_stress(self.slab.density, self.slab_thickness, self.slope_angle)
+        """Bed-normal stress of the slab on the weak layer (Pa), ``sum rho_i g h_i cos(theta)``."""
+        return stack_normal_stress(self.slab_stack(), self.slope_angle)
 
     def calibrated(self) -> CalibratedWeakLayer:
-        """The weak layer calibrated under this slab (:meth:`~mpm_warp.scenes.weak_layer.WeakLayer.calibrate`)."""
-        return self.weak_layer.calibrate(self.weak_layer_thickness, self.slab.density, self.slab_thickness,
-                                         abs(self.slope_angle), self.slab.E, self.slab.nu)
+        """The weak layer calibrated under this slab's load (:meth:`~mpm_warp.scenes.weak_layer.WeakLayer.
+        calibrate`; a layered slab enters through its mean density and thickness, the same normal stress, and
+        its bending-equivalent E and nu for the predictions)."""
+        eq = self.equivalent_slab()
+        return self.weak_layer.calibrate(self.weak_layer_thickness, eq.density, self.slab_depth,
+                                         abs(self.slope_angle), eq.E, eq.nu)
 
     @property
     def base_y(self) -> float:
         """Bed-normal position of the slab's base (m): substratum and weak layer below it."""
-        return self.substratum_thickness + self.weak_layer_thickness
+        return self.substratum_depth + self.weak_layer_thickness
 
     @property
     def saw_start(self) -> float:
@@ -203,10 +286,12 @@ class PSTParams:
 
     def distance_from_cut_end(self, x):
         """Distance (m) of positions ``x`` (m) from the end the saw starts at (its own inverse: distance to x)."""
-        return np.asarray(x, dtype=float) if self.saw.from_end == "left" else self.length - np.asarray(x, dtype=float)
+        return np.asarray(x, dtype=float) if self.cut_at_origin else self.length - np.asarray(x, dtype=float)
 
-    def references(self) -> dict[str, float]:
-        """Closed-form references of this PST (:mod:`mpm_warp.scenes.references`) with the calibrated layer.
+    def references(self, wl: CalibratedWeakLayer) -> dict[str, float]:
+        """Closed-form references of this PST (:mod:`mpm_warp.scenes.references`) with the calibrated layer ``wl``
+        (:meth:`calibrated`, or a scenario's stored calibration); a layered slab enters as its bending-equivalent
+        homogeneous slab (:meth:`equivalent_slab`).
 
         ``sigma_n``, ``p_oedometric`` (Pa); the layer's ``tau_p`` (Pa), ``w_f`` (J/m^2), ``delta_s``
         (m), ``collapse_height_calibrated`` (m, the debonded layer under this slab at rest); Heierli's
@@ -214,12 +299,28 @@ class PSTParams:
         (2017) ``critical_cut_gaume`` (m, flat ground); the slab's ``rayleigh_speed`` and
         ``shear_wave_speed`` (m/s).
         """
-        wl = self.calibrated()
-        slab = self.slab.material()
-        D = self.slab_thickness
+        slab = self.equivalent_slab().material()
+        D = self.slab_depth
         return {"sigma_n": self.sigma_n, "p_oedometric": oedometric_pressure(self.sigma_n, wl.material.nu),
                 "tau_p": wl.tau_p, "w_f": wl.w_f, "delta_s": wl.delta_s, "collapse_height_calibrated": wl.h_c,
                 "heierli_speed": heierli_speed(slab.E, D, slab.density, wl.h_c),
                 "heierli_touchdown": heierli_touchdown(slab.E, D, slab.density, wl.h_c),
                 "critical_cut_gaume": float(wl.critical_cut) if wl.critical_cut is not None else math.nan,
                 "rayleigh_speed": slab.rayleigh_speed, "shear_wave_speed": slab.s_wave_speed}
+
+
+def upgrade_table(table: dict) -> dict:
+    """A ``[scene]`` table of an older release in today's keys: ``saw.from_end = "left" | "right"`` (the end
+    ``x = 0`` or ``x = L``) becomes ``saw.cut_from``, the upslope or downslope end of that slope."""
+    saw = table.get("saw")
+    if isinstance(saw, dict) and "from_end" in saw:
+        end = saw.pop("from_end")
+        if "cut_from" in saw:
+            raise InvalidArgument("scene.saw.from_end", end, "left out beside scene.saw.cut_from (its older name)")
+        if end not in ("left", "right"):
+            raise InvalidArgument("scene.saw.from_end", end, "'left' or 'right' (older name of scene.saw.cut_from = "
+                                  "'upslope' | 'downslope')")
+        slope = table.get("slope_angle", 0.0)
+        up_at_origin = not isinstance(slope, (int, float)) or slope >= 0.0
+        saw["cut_from"] = "upslope" if (end == "left") == up_at_origin else "downslope"
+    return table

@@ -36,7 +36,7 @@ def shear_curves(params: ShearTestParams, times, series: dict) -> dict[str, np.n
             "bond_interior": part("bond_interior") if "bond_interior" in series else bond}
 
 
-def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
+def analyze_shear_series(params: ShearTestParams, calibration, times, series: dict) -> dict:
     """Peak and residual strength, softening displacement and collapse of a shear test, with references.
 
     On the layer's slip (:func:`shear_curves`): the peak and the residual of :func:`shear_summary`; the
@@ -49,7 +49,8 @@ def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
     given beside two laws: ``collapse_fraction_law`` (oedometric, the debonded layer under the slab at rest) and
     ``collapse_fraction_critical_state`` (the debonded, cohesionless layer at the critical state of its final
     mean Kirchhoff pressure ``p_final``: ``p0 = 2 p``; a sheared layer compacts more, docs/model.md §3b). The
-    calibrated layer's predictions (:meth:`ShearTestParams.references`) are copied in.
+    calibrated layer's predictions (``calibration``, the scenario's stored
+    :class:`~mpm_warp.scenes.weak_layer.CalibratedWeakLayer`; :meth:`ShearTestParams.references`) are copied in.
     """
     c = shear_curves(params, times, series)
     if len(c["u"]) < 3:
@@ -61,8 +62,8 @@ def analyze_shear_series(params: ShearTestParams, times, series: dict) -> dict:
     k = int(lost[0]) if len(lost) else -1
     k_all = int(lost_all[0]) if len(lost_all) else -1
     ip = sm.peak_index
-    refs = params.references()
-    mat = params.calibrated().material
+    refs = params.references(calibration)
+    mat = calibration.material
     p_end = float(np.asarray(series.get("p_kirchhoff", [math.nan]), dtype=float)[-1])
     # the debonded layer (cohesion beta b = 0) at the critical state: p0 = 2 p, p the Kirchhoff pressure
     cs = hardening_collapse(2.0 * p_end, mat.bulk, mat.xi, mat.p0_int_ini) \

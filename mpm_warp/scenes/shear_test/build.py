@@ -14,13 +14,15 @@ __all__ = ["build"]
 def build(params: ShearTestParams, time: TimeControl, output: Output | None = None, *, name: str = "shear_test",
           precision: str = "float32", description: str = "") -> Scenario:
     """The scenario of a shear test (parameters as :func:`mpm_warp.scenes.pst.build`; gravity is vertical): the
-    weak layer calibrated from its field quantities under the slab (:meth:`ShearTestParams.calibrated`)."""
+    weak layer calibrated from its field quantities under the slab (:meth:`ShearTestParams.calibrated`), once,
+    stored in :attr:`~mpm_warp.config.Scenario.calibration`."""
     p = params.validate()
     dx, Ls, d_wl, t_load = p.dx, p.sample_length, p.weak_layer_thickness, p.load_thickness
     sigma_n = p.sigma_n
     m = p.margin_cells
     box = plane_domain((-m, 0.0), (Ls + m, d_wl + t_load + m), dx, p.width, m)
-    materials = {"load": Elastic(p.slab.E, p.slab.nu, p.load_density), "weak_layer": p.calibrated().material}
+    cal = p.calibrated()
+    materials = {"load": Elastic(p.slab.E, p.slab.nu, p.load_density), "weak_layer": cal.material}
     ppc = p.particles_per_cell
     blocks = (Block("weak_layer", box.corner(0.0, 0.0), box.far_corner(Ls, d_wl), particles_per_cell=ppc,
                     name="weak_layer"),
@@ -31,4 +33,4 @@ def build(params: ShearTestParams, time: TimeControl, output: Output | None = No
                            f"wall at {p.wall_speed:g} m/s")
     return Scenario(name=name, domain=box.domain, time=settle_time(time, p.settle, box.vector(0.0, -GRAVITY)),
                     materials=materials, blocks=blocks, walls=(floor,), output=output or Output(),
-                    precision=precision, description=desc, scene=p)
+                    precision=precision, description=desc, scene=p, calibration={"weak_layer": cal.to_dict()})

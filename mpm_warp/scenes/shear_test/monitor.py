@@ -6,7 +6,7 @@ import numpy as np
 import warp as wp
 
 from ..series import SeriesMonitor, entries_below
-from ..weak_layer import ReferenceField, WeakLayerTracker
+from ..weak_layer import ReferenceField, WeakLayerTracker, stored_calibration
 from .analysis import analyze_shear_series
 from .kernels import push_kernel
 from .params import ShearTestParams
@@ -50,6 +50,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
         if not isinstance(p, ShearTestParams):
             raise TypeError("ShearMonitor needs a scenario built by mpm_warp.scenes.shear_test.build")
         self.params = p
+        self.calibration = stored_calibration(sim.scenario)
         self.sim = sim
         T = sim.model.T
         self.weak = WeakLayerTracker(sim, "weak_layer", p.push_start)
@@ -116,7 +117,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
     def result(self) -> dict:
         """Shear-test results from the series recorded so far (:func:`analyze_shear_series`)."""
         times, series = self.series_arrays()
-        return analyze_shear_series(self.params, times, series)
+        return analyze_shear_series(self.params, self.calibration, times, series)
 
 
 def attach(sim) -> ShearMonitor:

@@ -134,9 +134,9 @@ class ShearTestParams:
         return self.weak_layer.calibrate(self.weak_layer_thickness, self.slab.density, self.slab.thickness,
                                          abs(self.slope_angle), self.slab.E, self.slab.nu)
 
-    def references(self) -> dict[str, float]:
-        """The calibrated layer's predictions: ``sigma_n``, ``tau_p``, ``tau_peak`` (material-point peak), ``p0_ini``
-        (Pa); ``delta_s`` (m), ``w_f`` (J/m^2); ``collapse_fraction_law`` (-, the debonded layer under the slab)."""
-        wl = self.calibrated()
+    def references(self, wl: CalibratedWeakLayer) -> dict[str, float]:
+        """The calibrated layer's predictions (``wl``, :meth:`calibrated` or a scenario's stored calibration):
+        ``sigma_n``, ``tau_p``, ``tau_peak`` (material-point peak), ``p0_ini`` (Pa); ``delta_s`` (m), ``w_f``
+        (J/m^2); ``collapse_fraction_law`` (-, the debonded layer under the slab)."""
         return {"sigma_n": self.sigma_n, "tau_p": wl.tau_p, "tau_peak": wl.tau_peak, "p0_ini": wl.material.p0_ini,
                 "delta_s": wl.delta_s, "w_f": wl.w_f, "collapse_fraction_law": wl.h_c / self.weak_layer_thickness}

@@ -13,10 +13,10 @@ costs a fracture energy, then collapsing under the slab (the anticrack). Modules
   arrival times of one run (:class:`WeakLayerTracker`), and the ``log_jp_ref`` output field.
 """
 
-from .calibration import CalibratedWeakLayer, weac_collapse_height, weak_layer_material
+from .calibration import CalibratedWeakLayer, stored_calibration, weac_collapse_height, weak_layer_material
 from .kernels import weak_layer_kernel
 from .params import WeakLayer
 from .tracker import DAMAGE_BOND, ReferenceField, WeakLayerTracker, bin_median
 
-__all__ = ["WeakLayer", "CalibratedWeakLayer", "weak_layer_material", "weac_collapse_height", "WeakLayerTracker",
-           "ReferenceField", "weak_layer_kernel", "DAMAGE_BOND", "bin_median"]
+__all__ = ["WeakLayer", "CalibratedWeakLayer", "stored_calibration", "weak_layer_material", "weac_collapse_height",
+           "WeakLayerTracker", "ReferenceField", "weak_layer_kernel", "DAMAGE_BOND", "bin_median"]

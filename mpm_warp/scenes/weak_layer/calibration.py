@@ -59,6 +59,8 @@ the collapse, the critical cut length on flat ground (Gaume et al. 2017)
 Bergfeld et al. 2021).
 """
 
+from __future__ import annotations
+
 import math
 from dataclasses import asdict, dataclass, field, replace
 
@@ -78,8 +80,8 @@ from .paths import (
     xi_for_collapse,
 )
 
-__all__ = ["CalibratedWeakLayer", "weak_layer_material", "weac_collapse_height", "heierli_anticrack",
-           "shear_range", "CALIBRATION_RTOL"]
+__all__ = ["CalibratedWeakLayer", "stored_calibration", "weak_layer_material", "weac_collapse_height",
+           "heierli_anticrack", "shear_range", "CALIBRATION_RTOL"]
 
 CALIBRATION_RTOL = 1e-3
 """Relative tolerance of the ``kappa_s`` calibration on ``w_f`` or ``delta_s``."""
@@ -155,10 +157,17 @@ class CalibratedWeakLayer:
         return collapse_law(self.material, p0_int)
 
     def to_dict(self) -> dict:
-        """Plain dict (the material as its own dict)."""
+        """Plain dict (the material as its own dict); :meth:`from_dict` reads it back exactly."""
         d = asdict(self)
         d["material"] = self.material.to_dict()
         return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> CalibratedWeakLayer:
+        """The calibration stored by :meth:`to_dict` (e.g. in a run file's scenario), without running it again."""
+        d = dict(d)
+        mat = {k: v for k, v in d.pop("material").items() if k != "model"}
+        return cls(material=BondedCamClay(**mat), **d)
 
     @property
     def debond_energy(self) -> float:
@@ -199,6 +208,16 @@ class CalibratedWeakLayer:
         return "\n".join(lines)
 
     __str__ = describe
+
+
+def stored_calibration(scenario) -> CalibratedWeakLayer:
+    """The weak layer's calibration a snow scene's builder stored in ``scenario.calibration`` (never rerun)."""
+    stored = (scenario.calibration or {}).get("weak_layer")
+    if stored is None:
+        raise InvalidArgument("scenario.calibration", scenario.calibration,
+                              "the weak layer's calibration stored by the scene's builder (build the scenario with "
+                              "mpm_warp.scenes.pst.build or the loader)")
+    return CalibratedWeakLayer.from_dict(stored)
 
 
 def _exactly_one(a_name, a, b_name, b):
