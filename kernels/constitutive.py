@@ -50,15 +50,19 @@ import warp as wp
 
 from .bonded_camclay import bonded_camclay_return_strain_func, bonded_p0_func
 from .camclay import camclay_p0_func, camclay_project_func, camclay_return_strain_func, camclay_yield_func
+from .cracking import crack_func
 from .elasticity import hencky_strain_func
 from .logstrain import expm1_func, expm1_small_func, expm1_sym_func, log1p_func, log_strain_func
 from .principal import principal_strain_func
 from .types import mat, vec
 
-__all__ = ["MODELS", "YIELDED", "FLOORED", "INVERTED", "material_struct", "trial_func", "constitutive_update_func"]
+__all__ = ["MODELS", "PLASTIC_MODELS", "YIELDED", "FLOORED", "INVERTED", "material_struct", "trial_func",
+           "constitutive_update_func"]
 
 #: material models with a kernel-side update
-MODELS = ("elastic", "camclay", "bonded_camclay")
+MODELS = ("elastic", "camclay", "bonded_camclay", "tensile_cracking")
+#: the models with a return mapping (plastic state ``log_jp``)
+PLASTIC_MODELS = ("camclay", "bonded_camclay")
 YIELDED = 1
 FLOORED = 2
 INVERTED = 4
@@ -73,7 +77,9 @@ def material_struct(T):
     Fields: ``mu``, ``lam`` (Lame parameters, Pa); ``M`` (critical-state slope, -);
     ``beta`` (cohesion ratio, -); ``xi`` (hardening factor, -); ``p0_floor`` (Pa);
     ``s_floor`` (singular-value floor, -); ``p_bond`` (bonded consolidation pressure, Pa) and
-    ``kappa_s`` (plastic strain at which the bond is gone, -) of the bonded weak layer;
+    ``kappa_s`` (plastic strain at which the bond is gone, -) of the bonded weak layer; ``t_strength`` and
+    ``t_fail`` (Pa) of tensile cracking (``kernels/cracking.py``): the strength and the effective stress at
+    which the crack carries no tension;
     ``log_jp_ref`` (-): the hardening state of the material as placed, so that the plastic change of
     volume since then is ``exp(log_jp - log_jp_ref)`` (``log_jp`` starts at a consolidation's state,
     not at 0) and the Cauchy stress is ``tau / (J_E exp(log_jp - log_jp_ref))``.
@@ -91,6 +97,8 @@ def material_struct(T):
         p_bond: T
         kappa_s: T
         log_jp_ref: T
+        t_strength: T
+        t_fail: T
 
     return MaterialParams
 
@@ -123,10 +131,10 @@ def _model_funcs(T, model):
     through unchanged; the bonded layer runs its principal-strain return on the principal strains
     ``(m + r sqrt(2/3), m - r/sqrt(6), m - r/sqrt(6))``, ``m = tr/3``, which have those invariants.
     """
-    if model == "elastic":
-        return None, None, None
     if model not in MODELS:
         raise ValueError(f"unknown material model {model!r}; expected one of {MODELS}")
+    if model not in PLASTIC_MODELS:
+        return None, None, None
     P = material_struct(T)
     V3 = vec(3, T)
     yf = camclay_yield_func(T)
@@ -212,7 +220,8 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
     log_jp : T
         Hardening state ``ln det F_P`` (-); passed through by elastic models.
     kappa : T
-        Accumulated plastic strain of the bonded weak layer (-); passed through by the other models.
+        The softening state: the plastic work of the bonded weak layer (J/m^3), the largest effective tensile
+        stress of tensile cracking (Pa); passed through by the other models.
     m : MaterialParams
         See :func:`material_struct`.
 
@@ -225,7 +234,9 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
     M = mat(dim, T)
     V3 = vec(3, T)
     P = material_struct(T)
-    plastic = model != "elastic"
+    plastic = model in PLASTIC_MODELS
+    cracking = model == "tensile_cracking"
+    crack = crack_func(T, dim)
     yield_check, principal_return, invariant_return = _model_funcs(T, model)
     log_strain = log_strain_func(T, dim)
     log1p = log1p_func(T)
@@ -363,16 +374,33 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
                     return H_new, hzz_new, tau, lj_new, kap_new, flags
         return general(H_tr, hzz, lj, kap, m)
 
+    @wp.func
+    def update_cracking(H_tr: M, hzz: T, lj: T, kap: T, m: P):
+        """Elastic update, then the tensile cracking of the stress (``kernels/cracking.py``): ``YIELDED`` flags a
+        grown ``kappa``."""
+        H_new, hzz_new, tau, lj_new, kap_new, flags = update_any(H_tr, hzz, lj, kap, m)
+        if wp.static(cracking):
+            tau2, kap2, grew = crack(tau, kap, m.t_strength, m.t_fail)
+            if grew != 0:
+                flags = flags | YIELDED
+            return H_new, hzz_new, tau2, lj_new, kap2, flags
+        return H_new, hzz_new, tau, lj_new, kap_new, flags
+
     if dim == 2:
 
         @wp.func
         def update(H_tr: M, hzz: T, lj: T, kap: T, m: P):
+            if wp.static(cracking):
+                return update_cracking(H_tr, hzz, lj, kap, m)
             return update_any(H_tr, hzz, lj, kap, m)
 
     else:
 
         @wp.func
         def update(H_tr: M, lj: T, kap: T, m: P):
+            if wp.static(cracking):
+                H_new, hzz_new, tau, lj_new, kap_new, flags = update_cracking(H_tr, T(0.0), lj, kap, m)
+                return H_new, tau, lj_new, kap_new, flags
             H_new, hzz_new, tau, lj_new, kap_new, flags = update_any(H_tr, T(0.0), lj, kap, m)
             return H_new, tau, lj_new, kap_new, flags
 

@@ -14,6 +14,7 @@ import functools
 import warp as wp
 
 from .constitutive import material_struct
+from .cracking import crack_principal_func
 from .elasticity import cauchy_from_principal_func, hencky_strain_energy_func, hencky_strain_func
 from .principal import principal_strain_func
 from .types import mat, vec
@@ -26,7 +27,8 @@ def energy_kernel(dim, T):
     """Kinetic ``0.5 m |v|^2`` and elastic ``V0 psi(F_E)`` energy (J; J/m in plane strain) of one group.
 
     Accumulates into ``out[0]`` (kinetic) and ``out[1]`` (elastic), float64.
-    ``psi = mu |eps|^2 + lam/2 tr(eps)^2`` (Hencky, docs/model.md §1).
+    ``psi = mu |eps|^2 + lam/2 tr(eps)^2`` (Hencky, docs/model.md §1); a cracked particle (``kappa`` given,
+    cracking groups only, else an empty array) stores ``psi = tau' : eps / 2`` with its softened stress.
     """
     V = vec(dim, T)
     M = mat(dim, T)
@@ -36,10 +38,12 @@ def energy_kernel(dim, T):
     P = material_struct(T)
     principal_strain = principal_strain_func(D, dim)
     psi_fn = hencky_strain_energy_func(D)
+    hencky = hencky_strain_func(D)
+    crack64 = crack_principal_func(D, dim)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def energy(v: wp.array(dtype=V), H: wp.array(dtype=M), hzz: wp.array(dtype=T), mass: T, vol0: T, m: P,
-               out: wp.array(dtype=wp.float64)):
+    def energy(v: wp.array(dtype=V), H: wp.array(dtype=M), hzz: wp.array(dtype=T), kappa: wp.array(dtype=T),
+               mass: T, vol0: T, m: P, out: wp.array(dtype=wp.float64)):
         i = wp.tid()
         h = D(0.0)
         if wp.static(dim == 2):
@@ -47,6 +51,10 @@ def energy_kernel(dim, T):
                 h = D(hzz[i])
         U, eps, Vm, s, svd = principal_strain(MD(H[i]), h, D(m.s_floor))
         psi = psi_fn(eps, D(m.mu), D(m.lam))
+        if kappa.shape[0] > 0:  # a cracking group (kernels/cracking.py): the energy its softened stress stores
+            if D(kappa[i]) > D(m.t_strength):
+                tau = crack64(hencky(eps, D(m.mu), D(m.lam)), D(kappa[i]), D(m.t_strength), D(m.t_fail))
+                psi = D(0.5) * wp.dot(tau, eps)
         vi = v[i]
         wp.atomic_add(out, 0, D(0.5) * D(mass) * wp.dot(VD(vi), VD(vi)))
         wp.atomic_add(out, 1, D(vol0) * psi)
@@ -60,7 +68,8 @@ def stress_kernel(dim, T):
     ``q = sqrt(3/2)|dev tau|`` (Pa, Kirchhoff, compression positive) of one group.
 
     ``J = J_E exp(log_jp - log_jp_ref)`` is the volume ratio since the material was placed (``log_jp``
-    an empty array for elastic groups). In plane strain ``sigma`` holds the in-plane block and ``sigma_zz`` (the
+    an empty array for elastic groups; ``kappa`` an empty array but for cracking groups, whose stress is the
+    softened one). In plane strain ``sigma`` holds the in-plane block and ``sigma_zz`` (the
     out-of-plane stress the constraint ``F_zz = 1`` carries); ``sigma_xz =
     sigma_yz = 0``. Any of the outputs may be None-sized arrays not written.
     """
@@ -73,10 +82,11 @@ def stress_kernel(dim, T):
     principal_strain = principal_strain_func(D, dim)
     hencky = hencky_strain_func(D)
     cauchy_of = cauchy_from_principal_func(T, dim)
+    crack64 = crack_principal_func(D, dim)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def stress(H: wp.array(dtype=M), hzz: wp.array(dtype=T), log_jp: wp.array(dtype=T), m: P, want_sigma: int,
-               p_out: wp.array(dtype=T), q_out: wp.array(dtype=T), sigma_out: wp.array(dtype=M3)):
+    def stress(H: wp.array(dtype=M), hzz: wp.array(dtype=T), log_jp: wp.array(dtype=T), kappa: wp.array(dtype=T), m: P,
+               want_sigma: int, p_out: wp.array(dtype=T), q_out: wp.array(dtype=T), sigma_out: wp.array(dtype=M3)):
         i = wp.tid()
         h = D(0.0)
         if wp.static(dim == 2):
@@ -85,6 +95,8 @@ def stress_kernel(dim, T):
         sf = D(m.s_floor)
         U, eps, Vm, s, svd = principal_strain(MD(H[i]), h, sf)
         tau = hencky(eps, D(m.mu), D(m.lam))
+        if kappa.shape[0] > 0:  # a cracking group: the softened stress (kernels/cracking.py)
+            tau = crack64(tau, D(kappa[i]), D(m.t_strength), D(m.t_fail))
         p = -(tau[0] + tau[1] + tau[2]) / D(3.0)
         dev = tau + V3(p, p, p)
         p_out[i] = T(p)

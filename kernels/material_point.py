@@ -25,7 +25,8 @@ import warp as wp
 
 from .bonded_camclay import bonded_p0_func
 from .camclay import camclay_p0_func
-from .constitutive import constitutive_update_func, material_struct, trial_func
+from .constitutive import PLASTIC_MODELS, constitutive_update_func, material_struct, trial_func
+from .cracking import crack_principal_func
 from .elasticity import cauchy_from_principal_func, hencky_strain_func
 from .principal import principal_strain_func
 from .types import mat, vec
@@ -53,7 +54,9 @@ def drive_kernel(dim, T, model):
     cauchy_of = cauchy_from_principal_func(T, dim)
     p0f = camclay_p0_func(T)
     bp0f = bonded_p0_func(T)
-    plastic = model != "elastic"
+    plastic = model in PLASTIC_MODELS
+    cracking = model == "tensile_cracking"
+    crack64 = crack_principal_func(D, dim)
     max_it = MAX_CONTROL_ITERATIONS
 
     @wp.func
@@ -67,10 +70,13 @@ def drive_kernel(dim, T, model):
             return H_tr, H_new, hzz, lj_new, kap_new, flags
 
     @wp.func
-    def cauchy(H: M, hzz: T, lj: T, m: P):
-        """Cauchy stress (tau / J), principal strains and Kirchhoff principal stresses of a state (float64)."""
+    def cauchy(H: M, hzz: T, lj: T, kap: T, m: P):
+        """Cauchy stress (tau / J), principal strains and Kirchhoff principal stresses of a state (float64); a
+        cracking material's stress softened by its ``kappa`` (``kernels/cracking.py``)."""
         U, eps, Vm, s, svd = principal64(MD(H), D(hzz), D(m.s_floor))
         tau = hencky64(eps, D(m.mu), D(m.lam))
+        if wp.static(cracking):
+            tau = crack64(tau, D(kap), D(m.t_strength), D(m.t_fail))
         J = wp.exp(eps[0] + eps[1] + eps[2] + D(lj) - D(m.log_jp_ref))
         return cauchy_of(U, tau, J), V3(eps), V3(tau)
 
@@ -103,7 +109,7 @@ def drive_kernel(dim, T, model):
     @wp.func
     def residual(H: M, hzz: T, lj: T, kap: T, L: M, m: P, mask: Vd, target: Vd):
         H_tr, H_new, hzz_new, lj_new, kap_new, flags = step(H, hzz, lj, kap, L, m)
-        sig, e, tau = cauchy(H_new, hzz_new, lj_new, m)
+        sig, e, tau = cauchy(H_new, hzz_new, lj_new, kap_new, m)
         r = Vd()
         for a in range(dim):
             if mask[a] != T(0.0):
@@ -231,14 +237,14 @@ def drive_kernel(dim, T, model):
                 lj = lj_new
                 kap = kap_new
             F_out[i, k] = F_prev
-            sig_t, e_t, tau_t = cauchy(H_tr, hzz, lj, m)
+            sig_t, e_t, tau_t = cauchy(H_tr, hzz, lj, kap, m)
             eps_trial[i, k] = e_t
             H_out[i, k] = H
             hzz_out[i, k] = hzz
             lj_out[i, k] = lj
             kap_out[i, k] = kap
             yielded[i, k] = flags & 1
-            sig, e_k, tau = cauchy(H, hzz, lj, m)
+            sig, e_k, tau = cauchy(H, hzz, lj, kap, m)
             sigma[i, k] = sig
             eps[i, k] = e_k
             p = -(tau[0] + tau[1] + tau[2]) / T(3.0)

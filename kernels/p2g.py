@@ -30,7 +30,15 @@ import functools
 
 import warp as wp
 
-from .constitutive import FLOORED, INVERTED, YIELDED, constitutive_update_func, material_struct, trial_func
+from .constitutive import (
+    FLOORED,
+    INVERTED,
+    PLASTIC_MODELS,
+    YIELDED,
+    constitutive_update_func,
+    material_struct,
+    trial_func,
+)
 from .shape import NONNEG, in_grid_func, stencil_func
 from .types import mat, vec
 
@@ -47,7 +55,7 @@ def p2g_kernel(dim, T, model, track_yield):
         ``wp.float32`` or ``wp.float64``.
     model : str
         Material model of the group (see ``kernels.constitutive.MODELS``); plastic
-        models read and write ``log_jp``, the bonded weak layer also ``kappa``.
+        models read and write ``log_jp``, the bonded weak layer and tensile cracking ``kappa``.
     track_yield : bool
         Also set ``yielded[i] = 1`` where the return was active (output field).
     """
@@ -59,8 +67,9 @@ def p2g_kernel(dim, T, model, track_yield):
     in_grid = in_grid_func(dim)
     trial = trial_func(T, dim)
     update = constitutive_update_func(dim, T, model)
-    plastic = model != "elastic"
+    plastic = model in PLASTIC_MODELS
     bonded = model == "bonded_camclay"
+    cracking = model == "tensile_cracking"
 
     @wp.kernel(enable_backward=False, module="unique")
     def p2g(
@@ -95,7 +104,7 @@ def p2g_kernel(dim, T, model, track_yield):
         kap = T(0.0)
         if wp.static(plastic):
             lj = log_jp[i]
-        if wp.static(bonded):
+        if wp.static(bonded or cracking):
             kap = kappa[i]
         if wp.static(dim == 2 and plastic):
             H_new, hzz_new, tau, lj_new, kap_new, flags = update(H_tr, hzz[i], lj, kap, m)
@@ -113,6 +122,9 @@ def p2g_kernel(dim, T, model, track_yield):
                         kappa[i] = kap_new
                     if wp.static(track_yield):
                         yielded[i] = wp.uint8(1)
+            if wp.static(cracking):
+                if (flags & YIELDED) != 0:
+                    kappa[i] = kap_new
             if (flags & FLOORED) != 0:
                 wp.atomic_add(counts, 2, 1)
             if (flags & INVERTED) != 0:

@@ -27,15 +27,15 @@ from .config import Block, Domain, Output, Scenario, TimeControl  # noqa: E402
 from .errors import InvalidArgument, MPMError, OutputError, ScenarioError, SimulationBlowUp  # noqa: E402
 from .io import RunData, read_run  # noqa: E402
 from .loader import apply_overrides, list_scenes, load_scenario, scenarios_dir  # noqa: E402
-from .materials import BondedCamClay, CamClaySnow, Elastic  # noqa: E402
+from .materials import BondedCamClay, CamClaySnow, CrackingSnow, Elastic  # noqa: E402
 from .result import RunResult  # noqa: E402
 from .runner import resume, run  # noqa: E402
 from .simulation import Simulation  # noqa: E402
 from .walls import Wall, box_walls  # noqa: E402
 
 __all__ = [
-    "Block", "BondedCamClay", "CamClaySnow", "Domain", "Elastic", "InvalidArgument", "MPMError", "Output",
-    "OutputError",
+    "Block", "BondedCamClay", "CamClaySnow", "CrackingSnow", "Domain", "Elastic", "InvalidArgument", "MPMError",
+    "Output", "OutputError",
     "RunData", "RunResult", "Scenario", "ScenarioError", "Simulation", "SimulationBlowUp", "TimeControl",
     "Wall", "apply_overrides", "box_walls", "list_scenes", "load_scenario", "read_run", "resume", "run",
     "scenarios_dir", "__version__",

@@ -45,7 +45,9 @@ OUTPUT_FIELDS = {
     "F": ((3, 3), "1", "elastic deformation gradient F_E (plane strain: in-plane block and F_zz)"),
     "stress": ((3, 3), "Pa", "Cauchy stress tensor, tension positive (plane strain: in-plane block and sigma_zz)"),
     "log_jp": ((), "1", "ln det F_P (0 for elastic particles)"),
-    "kappa": ((), "1", "accumulated plastic strain of a bonded weak layer, its bond 1 - kappa/kappa_s (0 elsewhere)"),
+    "kappa": ((), "J/m^3 or Pa", "softening state: plastic work of a bonded weak layer (J/m^3; its bond is "
+              "1 - kappa/kappa_s), largest effective tensile stress of a cracking slab (Pa); 0 elsewhere"),
+    "damage": ((), "1", "damage 0-1: 1 - bond of a bonded weak layer, tensile damage of a cracking slab; 0 elsewhere"),
     "p": ((), "Pa", "pressure -tr(tau)/3, Kirchhoff, compression positive"),
     "q": ((), "Pa", "Mises stress sqrt(3/2)|dev tau|, Kirchhoff"),
     "yielded": ((), "1", "1 where the Cam-Clay return was active during the frame"),

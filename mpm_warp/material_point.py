@@ -232,7 +232,7 @@ def drive_material_points(F_path=None, *, L_path=None, F_total=None, material=No
         Ft[..., 2, 2] = 1.0
     res["F"] = Ft
     J = np.exp(res["eps"].astype(np.float64).sum(axis=-1))
-    if model != "elastic":
+    if mats[0].plastic:
         J = J * np.exp(res["log_jp"].astype(np.float64) - np.array([m.initial_log_jp for m in mats])[:, None])
     else:
         res.pop("p0")
@@ -240,6 +240,8 @@ def drive_material_points(F_path=None, *, L_path=None, F_total=None, material=No
     if model == "bonded_camclay":
         ks = np.array([m.kappa_s for m in mats])[:, None]
         res["bond"] = np.maximum(0.0, 1.0 - res["kappa"].astype(np.float64) / ks)
+    elif model == "tensile_cracking":
+        res["damage"] = np.stack([m.damage(res["kappa"][k]) for k, m in enumerate(mats)])
     else:
         res.pop("kappa")
     return res

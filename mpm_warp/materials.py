@@ -12,9 +12,10 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from .checks import finite_number
+from .errors import InvalidArgument
 from .kernels.camclay import initial_log_jp
 
-__all__ = ["Elastic", "CamClaySnow", "BondedCamClay", "Material", "MATERIAL_MODELS", "lame_parameters",
+__all__ = ["Elastic", "CamClaySnow", "BondedCamClay", "CrackingSnow", "Material", "MATERIAL_MODELS", "lame_parameters",
            "hardening_collapse"]
 
 
@@ -239,6 +240,73 @@ class BondedCamClay(Elastic):
         return 0.0
 
 
-Material = Elastic | CamClaySnow | BondedCamClay
-MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow, "bonded_camclay": BondedCamClay}
+@dataclass(frozen=True)
+class CrackingSnow(Elastic):
+    """Elastic snow that cracks in tension: a slab that can break (docs/model.md §9; ``kernels/cracking.py``).
+
+    Hencky elasticity as :class:`Elastic` until the largest principal stress reaches the tensile strength;
+    then the tensile stress softens linearly to nothing while the fracture energy is spent over a crack band
+    of width ``band_width`` (Bazant and Oh 1983): the effective stress at full damage is
+    :attr:`failure_stress` ``= 2 E G_f / (sigma_t h)``. Compression is carried throughout (a crack closes).
+    Kernel state: ``kappa``, the largest effective tensile stress so far (Pa).
+
+    Parameters
+    ----------
+    E, nu, density : float
+        Elasticity as in :class:`Elastic`.
+    tensile_strength : float
+        Tensile strength ``sigma_t`` (Pa), > 0.
+    fracture_energy : float
+        Mode-I fracture energy ``G_f`` (J/m^2), > 0.
+    band_width : float
+        Width ``h`` of the band a crack localises in (m), > 0: the grid spacing of the scene. At most
+        ``2 E G_f / sigma_t^2``, the width beyond which the softening would snap back.
+    """
+
+    tensile_strength: float = 5.0e3
+    fracture_energy: float = 0.1
+    band_width: float = 0.01
+    model: str = field(default="tensile_cracking", init=False)
+    plastic = False
+
+    @property
+    def failure_stress(self) -> float:
+        """Effective tensile stress at full damage, ``2 E G_f / (sigma_t h)`` (Pa)."""
+        return 2.0 * self.E * self.fracture_energy / (self.tensile_strength * self.band_width)
+
+    @property
+    def max_band_width(self) -> float:
+        """The widest band without snap-back, ``2 E G_f / sigma_t^2`` (m)."""
+        return 2.0 * self.E * self.fracture_energy / self.tensile_strength**2
+
+    @property
+    def initial_kappa(self) -> float:
+        """``kappa(0) = 0``: never loaded beyond its strength."""
+        return 0.0
+
+    def damage(self, kappa):
+        """Damage ``d`` (-, 0 intact to 1 a traction-free crack) at the largest effective tensile stress ``kappa``
+        (Pa, float or array): the host mirror of ``kernels/cracking.py``'s ``damage``."""
+        k = np.asarray(kappa, dtype=np.float64)
+        st, sf = self.tensile_strength, self.failure_stress
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d = np.where(k <= st, 0.0, np.where(k >= sf, 1.0, 1.0 - (st / k) * (sf - k) / (sf - st)))
+        return float(d) if d.ndim == 0 else d
+
+    def validate(self, where: str = "material") -> CrackingSnow:
+        """Check every parameter; raise InvalidArgument naming ``where.field``."""
+        super().validate(where)
+        finite_number(f"{where}.tensile_strength", self.tensile_strength, lo=0.0, lo_open=True)
+        finite_number(f"{where}.fracture_energy", self.fracture_energy, lo=0.0, lo_open=True)
+        h = finite_number(f"{where}.band_width", self.band_width, lo=0.0, lo_open=True)
+        if h >= self.max_band_width:
+            raise InvalidArgument(f"{where}.band_width", h, (
+                f"a crack band narrower than 2 E G_f / sigma_t^2 = {self.max_band_width:.3g} m (wider, the softening "
+                "snaps back): refine the grid, or raise the fracture energy or lower the tensile strength"))
+        return self
+
+
+Material = Elastic | CamClaySnow | BondedCamClay | CrackingSnow
+MATERIAL_MODELS = {"elastic": Elastic, "camclay": CamClaySnow, "bonded_camclay": BondedCamClay,
+                   "tensile_cracking": CrackingSnow}
 

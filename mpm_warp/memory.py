@@ -3,7 +3,7 @@
 Per particle on the device, with ``s`` = 4 bytes (float32) or 8 (float64) and ``d`` the dimension:
 ``x``, ``v`` (``d s`` each), ``C``, ``H = F_E - I`` (``d^2 s`` each), for plastic (Cam-Clay) particles
 ``log_jp`` (``s``) and in plane strain ``hzz`` (``s``; an elastic particle's ``F_E,zz`` is 1, not
-stored), for bonded ones ``kappa`` (``s``) and, when the output asks for it, ``yielded`` (1 byte). A
+stored), for bonded and cracking ones ``kappa`` (``s``) and, when the output asks for it, ``yielded`` (1 byte). A
 bonded weak layer also has its lattice columns: a column index per particle (int32, on the device and on
 the host) and a float64 pair per column. The grid is ``n_copies x nodes x (1 + d)`` scalars (mass and
 momentum; one copy per CPU thread, :func:`mpm_warp.step.grid_copies`). The host keeps the seeded
@@ -63,12 +63,14 @@ def format_bytes(n: float) -> str:
 
 
 def particle_bytes(dim: int, precision: str, *, plastic: bool = False, bonded: bool = False,
-                   yielded: bool = False) -> int:
+                   yielded: bool = False, cracking: bool = False) -> int:
     """Device bytes of one particle (see the module docstring)."""
     s = 8 if precision == "float64" else 4
     b = (2 * dim + 2 * dim * dim) * s
     if plastic:
         b += s + (s if dim == 2 else 0) + (s if bonded else 0) + (1 if yielded else 0)
+    if cracking:
+        b += s
     return b
 
 
@@ -125,7 +127,8 @@ def estimate_memory(scenario: Scenario, device: str, n_threads: int | None = Non
         mat = scenario.materials[b.material]
         bonded = mat.model == "bonded_camclay"
         n += count
-        part += count * particle_bytes(dim, prec, plastic=mat.plastic, bonded=bonded, yielded=yielded)
+        part += count * particle_bytes(dim, prec, plastic=mat.plastic, bonded=bonded, yielded=yielded,
+                                       cracking=mat.model == "tensile_cracking")
         if bonded:                 # column index (int32) per particle, a vec2d of sums per column (all but y)
             bonded_n += count
             columns += count * 4 + (count // counts[1]) * 16

@@ -22,13 +22,15 @@ from .kernels.camclay import SINGULAR_VALUE_FLOOR
 from .kernels.constitutive import material_struct
 from .kernels.grid_update import wall_struct
 from .kernels.types import mat, vec
-from .materials import BondedCamClay, CamClaySnow, Elastic
+from .materials import BondedCamClay, CamClaySnow, CrackingSnow, Elastic
 
 __all__ = ["Model", "State", "ParticleGroup", "seed_block", "lattice_counts", "lattice_columns", "grid_shape",
            "velocity_gradient", "material_params", "SINGULAR_VALUE_FLOOR", "GRID_PADDING"]
 
 #: grid nodes added outside the domain box on each side
 GRID_PADDING = 3
+#: material models with a softening state ``kappa`` per particle
+SOFTENING_MODELS = ("bonded_camclay", "tensile_cracking")
 
 
 @dataclass
@@ -37,7 +39,8 @@ class ParticleGroup:
 
     ``start:end`` indexes the particle arrays; ``plastic_start`` indexes
     ``log_jp`` (Cam-Clay groups only, else -1) and, for a bonded weak layer
-    (whose groups come first among the plastic ones), ``kappa`` too;
+    (whose groups come first among the plastic ones), ``kappa`` too; ``kappa_start`` indexes ``kappa``
+    (bonded and cracking groups, else -1);
     ``columns`` (bonded groups) the lattice column of each particle
     (:func:`lattice_columns`) and ``n_columns`` their count.
     """
@@ -52,6 +55,7 @@ class ParticleGroup:
     plastic_start: int = -1
     columns: np.ndarray | None = None
     n_columns: int = 0
+    kappa_start: int = -1
 
     @property
     def count(self) -> int:
@@ -100,6 +104,8 @@ def material_params(material: Elastic, T):
         m.log_jp_ref = T(material.initial_log_jp)
     if isinstance(material, BondedCamClay):
         m.p_bond, m.kappa_s = T(material.p_bond), T(material.kappa_s)
+    if isinstance(material, CrackingSnow):
+        m.t_strength, m.t_fail = T(material.tensile_strength), T(material.failure_stress)
     return m
 
 
@@ -185,14 +191,18 @@ class Model:
         self.c_p = max(m.p_wave_speed for m in scenario.materials.values())
         self.gravity = np.asarray(scenario.time.gravity, dtype=np.float64)
 
-        # particle groups: bonded weak layers, then the other plastic groups, then elastic ones, so that kappa and
-        # log_jp are contiguous prefixes
-        blocks = sorted(scenario.blocks, key=lambda b: (not scenario.materials[b.material].plastic,
-                                                        scenario.materials[b.material].model != "bonded_camclay"))
+        # particle groups: bonded weak layers, the other plastic groups, cracking ones, then elastic ones, so that
+        # log_jp is a contiguous prefix and kappa holds the bonded groups (from 0) and then the cracking ones
+        def order(b):
+            m = scenario.materials[b.material]
+            return not m.plastic, m.model != "bonded_camclay", m.model != "tensile_cracking"
+
+        blocks = sorted(scenario.blocks, key=order)
         self.groups: list[ParticleGroup] = []
         self._seed = []
         start = 0
         pstart = 0
+        kstart = 0
         self.n_bonded = 0
         for b in blocks:
             mat = scenario.materials[b.material]
@@ -209,6 +219,9 @@ class Model:
                 g.columns = cols[keep] if b.halfspaces else cols
                 g.n_columns = int(cols.max()) + 1
                 self.n_bonded += n
+            if mat.model in SOFTENING_MODELS:
+                g.kappa_start = kstart
+                kstart += n
             if mat.plastic:
                 pstart += n
             start += n
@@ -216,6 +229,8 @@ class Model:
             self._seed.append((b, x))
         self.n_particles = start
         self.n_plastic = pstart
+        #: particles with a softening state ``kappa`` (bonded weak layers, then cracking groups)
+        self.n_kappa = kstart
         # nodes lighter than this are empty. The node velocity (sum w (m v + A dpos)) / (sum w m) is well defined for
         # any positive mass, so the threshold only keeps float32 away from denormals (1e-20 of a particle's mass);
         # dropping nodes a particle reaches with a weight of 1e-9 broke momentum conservation at 1e-10
@@ -256,12 +271,12 @@ class Model:
             else:
                 v[g.start:g.end] = np.broadcast_to(np.asarray(b.velocity), xb.shape)
         ljp = np.zeros(self.n_plastic, dtype=self.np_dtype)
-        kappa = np.zeros(self.n_bonded, dtype=self.np_dtype)
+        kappa = np.zeros(self.n_kappa, dtype=self.np_dtype)
         for g in self.groups:
             if g.material.plastic:
                 ljp[g.plastic_start:g.plastic_start + g.count] = g.material.initial_log_jp
-            if g.columns is not None:
-                kappa[g.plastic_start:g.plastic_start + g.count] = g.material.initial_kappa
+            if g.kappa_start >= 0:
+                kappa[g.kappa_start:g.kappa_start + g.count] = g.material.initial_kappa
         return State(self, x, v, C, ljp, kappa, track_yield)
 
     def bytes_per_particle(self, state: State) -> float:
@@ -287,8 +302,9 @@ class State:
         (indexed as ``log_jp``); an elastic particle's ``F_E,zz`` is the total, 1, and is not stored.
     log_jp : wp.array, (N_plastic,) or None
         ln det F_P of Cam-Clay particles.
-    kappa : wp.array, (N_bonded,) or None
-        Accumulated plastic strain of bonded weak-layer particles (-), the first plastic ones.
+    kappa : wp.array, (N_kappa,) or None
+        The softening state of the bonded weak-layer particles (plastic work, J/m^3; the first plastic ones)
+        and then of the cracking ones (largest effective tensile stress, Pa), indexed by ``kappa_start``.
     yielded : wp.array of uint8, (N_plastic,) or None
         Return-mapping activity flag, only when the output asks for it.
     clock : wp.array of float64, (4,)
@@ -313,7 +329,7 @@ class State:
         self.H = wp.zeros(n, dtype=M, device=dev)
         self.hzz = wp.zeros(model.n_plastic, dtype=T, device=dev) if d == 2 and model.n_plastic else None
         self.log_jp = wp.array(log_jp, dtype=T, device=dev) if model.n_plastic else None
-        self.kappa = wp.array(kappa, dtype=T, device=dev) if model.n_bonded else None
+        self.kappa = wp.array(kappa, dtype=T, device=dev) if model.n_kappa else None
         track = track_yield and model.n_plastic > 0
         self.yielded = wp.zeros(model.n_plastic, dtype=wp.uint8, device=dev) if track else None
         self.clock = wp.zeros(4, dtype=wp.float64, device=dev)

@@ -114,7 +114,7 @@ class Simulation:
         plastic = g.plastic_start >= 0
         return GroupState(g.name, g.material, g.start, g.end, g.mass, g.vol0, s.x[sl], s.v[sl], s.C[sl], s.H[sl],
                           s.hzz[psl] if plastic and s.hzz is not None else None, s.log_jp[psl] if plastic else None,
-                          self.x0[sl], s.kappa[psl] if g.columns is not None else None)
+                          self.x0[sl], s.kappa[g.kappa_start:g.kappa_start + g.count] if g.kappa_start >= 0 else None)
 
     def _hzz_of(self, g) -> wp.array:
         """``hzz`` of group ``g``'s particles, or an empty array (elastic or 3D: ``F_E,zz`` not stored)."""
@@ -122,6 +122,12 @@ class Simulation:
         if s.hzz is None or g.plastic_start < 0:
             return self._no_log_jp
         return s.hzz[g.plastic_start:g.plastic_start + g.count]
+
+    def _kappa_of_cracking(self, g) -> wp.array:
+        """``kappa`` of a cracking group's particles (their softened stress), else an empty array."""
+        if g.material.model != "tensile_cracking":
+            return self._no_log_jp
+        return self.state.kappa[g.kappa_start:g.kappa_start + g.count]
 
     def energies(self) -> dict[str, float]:
         """Kinetic and elastic energy (J; J/m of depth in 2D) of the current state."""
@@ -132,8 +138,8 @@ class Simulation:
             sl = slice(g.start, g.end)
             hz = self._hzz_of(g)
             wp.launch(energy_kernel(self.model.dim, T), g.count,
-                      inputs=[s.v[sl], s.H[sl], hz, T(g.mass), T(g.vol0), material_params(g.material, T),
-                              self._energy], device=self.device)
+                      inputs=[s.v[sl], s.H[sl], hz, self._kappa_of_cracking(g), T(g.mass), T(g.vol0),
+                              material_params(g.material, T), self._energy], device=self.device)
         e = self._energy.numpy()
         return {"kinetic_energy": float(e[0]), "elastic_energy": float(e[1])}
 
@@ -152,8 +158,8 @@ class Simulation:
             hz = self._hzz_of(g)
             ljp = s.log_jp[g.plastic_start:g.plastic_start + g.count] if g.plastic_start >= 0 else self._no_log_jp
             wp.launch(stress_kernel(self.model.dim, T), g.count,
-                      inputs=[s.H[sl], hz, ljp, material_params(g.material, T), int(cauchy), p[sl], q[sl],
-                              sig[sl] if cauchy else None],
+                      inputs=[s.H[sl], hz, ljp, self._kappa_of_cracking(g), material_params(g.material, T), int(cauchy),
+                              p[sl], q[sl], sig[sl] if cauchy else None],
                       device=self.device)
         return p.numpy(), q.numpy(), sig.numpy() if cauchy else None
 
@@ -178,8 +184,20 @@ class Simulation:
             if arr is not None:
                 a = arr.numpy()
                 for g in self.model.groups:
-                    if g.plastic_start >= 0 and (name == "log_jp" or g.columns is not None):
-                        out[g.start:g.end] = a[g.plastic_start:g.plastic_start + g.count]
+                    at = g.plastic_start if name == "log_jp" else g.kappa_start
+                    if at >= 0:
+                        out[g.start:g.end] = a[at:at + g.count]
+            return out
+        if name == "damage":
+            out = np.zeros(n, dtype=self.model.np_dtype)
+            if s.kappa is not None:
+                a = s.kappa.numpy().astype(np.float64)
+                for g in self.model.groups:
+                    k = a[g.kappa_start:g.kappa_start + g.count] if g.kappa_start >= 0 else None
+                    if g.material.model == "tensile_cracking":
+                        out[g.start:g.end] = g.material.damage(k)
+                    elif g.material.model == "bonded_camclay":
+                        out[g.start:g.end] = np.minimum(1.0, k / g.material.kappa_s)
             return out
         if name in ("p", "q"):
             p, q = self.stress_invariants()

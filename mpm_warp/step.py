@@ -129,10 +129,11 @@ class Stepper:
                     continue
                 sl = slice(a, b)
                 ljp, kap, yld, hz = unused[T], unused[T], unused[wp.uint8], unused[T]
+                if g.kappa_start >= 0:
+                    kap = s.kappa[g.kappa_start + a - g.start:g.kappa_start + b - g.start]
                 if plastic:
                     psl = slice(g.plastic_start + a - g.start, g.plastic_start + b - g.start)
                     ljp = s.log_jp[psl]
-                    kap = s.kappa[psl] if g.columns is not None else kap
                     yld = s.yielded[psl] if s.yielded is not None else yld
                     hz = s.hzz[psl] if s.hzz is not None else hz
                 self._p2g[k].append(wp.launch(

@@ -1,0 +1,140 @@
+"""Tensile cracking of the slab (kernels/cracking.py, docs/model.md §9): onset, softening, energy, leave-out."""
+
+import numpy as np
+import pytest
+
+import mpm_warp as mw
+from mpm_warp.errors import InvalidArgument
+from mpm_warp.material_point import drive_material_points
+
+E, NU, RHO = 5e6, 0.25, 200.0
+ST, GF, H = 5e3, 0.2, 0.01          # Pa, J/m^2, m: failure stress 2 E G_f / (st h) = 40 kPa
+
+
+def cracking(**kw):
+    return mw.CrackingSnow(**{"E": E, "nu": NU, "density": RHO, "tensile_strength": ST, "fracture_energy": GF,
+                              "band_width": H, **kw})
+
+
+def uniaxial_tension(mat, eps_max, n=400, dtype="float64", rotation=None):
+    """Uniaxial stress along x (y and z stress-free) to ``eps_max``; optionally in a rotated frame."""
+    F = np.tile(np.eye(3), (n, 1, 1))
+    F[:, 0, 0] = np.exp(np.linspace(eps_max / n, eps_max, n))
+    if rotation is not None:
+        F = rotation @ F @ rotation.T
+        return drive_material_points(F_total=F, material=mat, dtype=dtype)
+    # lateral stresses held to 0.01 Pa: the softened axial stress is then free of the control's error
+    return drive_material_points(F_total=F, material=mat, dtype=dtype, stress_tol=0.01,
+                                 stress_control={"axes": (False, True, True), "sigma": (0.0, 0.0, 0.0)})
+
+
+@pytest.mark.parametrize("dtype", ["float64", "float32"])
+def test_uniaxial_tension_softens_linearly_and_spends_the_fracture_energy(dtype):
+    mat = cracking()
+    assert mat.failure_stress == pytest.approx(2 * E * GF / (ST * H))
+    eps_f = mat.failure_stress / E
+    r = uniaxial_tension(mat, 1.25 * eps_f, dtype=dtype)
+    s = r["stress"][0, :, 0, 0].astype(float)
+    e = np.log(r["F"][0, :, 0, 0])
+    # elastic to the strength (within one increment), then the linear softening law, then traction-free
+    assert s.max() == pytest.approx(ST, rel=5e-3)
+    soft = (e > 1.05 * ST / E) & (e < 0.95 * eps_f)
+    want = ST * (eps_f - e[soft]) / (eps_f - ST / E)
+    np.testing.assert_allclose(s[soft], want, rtol=2e-3, atol=2e-3 * ST)
+    assert np.all(np.abs(s[e > 1.01 * eps_f]) < 1e-6 * ST) and r["damage"][0, -1] == 1.0
+    # the work per unit volume is G_f / h: the fracture energy spent over the band
+    assert np.trapezoid(s, e) == pytest.approx(GF / H, rel=5e-3)
+    # the kernel's damage is the host formula of the material
+    np.testing.assert_allclose(r["damage"][0], mat.damage(r["kappa"][0]), rtol=1e-6)
+
+
+def test_a_crack_closes_in_compression_and_keeps_its_damage():
+    mat = cracking()
+    n = 200
+    eps = np.concatenate([np.linspace(0, 0.5 * mat.failure_stress / E, n), np.linspace(0.5 * mat.failure_stress / E,
+                                                                                        -2e-3, n)])[1:]
+    F = np.tile(np.eye(3), (len(eps), 1, 1))
+    F[:, 0, 0] = np.exp(eps)
+    r = drive_material_points(F_total=F, material=mat, dtype="float64",
+                              stress_control={"axes": (False, True, True), "sigma": (0.0, 0.0, 0.0)})
+    s = r["tau"][0, 1:, 0, 0]                     # Kirchhoff: uniaxial Hencky gives tau = E eps exactly
+    d = r["damage"][0, 1:]
+    back = np.arange(len(eps)) >= n
+    assert d[n] > 0.3 and np.all(np.diff(d) >= -1e-15)          # damage never heals
+    # unloading in tension follows the secant (1 - d) E eps; in compression the full stiffness returns
+    comp = back & (eps < -1e-4)
+    np.testing.assert_allclose(s[comp], E * eps[comp], rtol=1e-3)
+    ten = back & (eps > 1e-4)
+    np.testing.assert_allclose(s[ten], (1 - d[ten]) * E * eps[ten], rtol=1e-3)
+
+
+def test_the_criterion_is_objective_in_3d():
+    # the same tension along a rotated axis (uniaxial strain, no control): the same principal stresses
+    mat = cracking()
+    c, s = np.cos(0.7), np.sin(0.7)
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    a = uniaxial_tension(mat, 5e-3, rotation=np.eye(3))
+    b = uniaxial_tension(mat, 5e-3, rotation=R)
+    sa = np.linalg.eigvalsh(a["stress"][0])
+    sb = np.linalg.eigvalsh(b["stress"][0])
+    np.testing.assert_allclose(sb, sa, rtol=1e-9, atol=1e-9 * ST)
+    assert a["damage"][0, -1] > 0.0
+    np.testing.assert_allclose(b["damage"][0], a["damage"][0], rtol=1e-9, atol=1e-12)
+
+
+def test_below_its_strength_a_cracking_slab_is_the_elastic_slab_bit_for_bit():
+    # the driver: stresses below the strength are the elastic ones to the last bit
+    el = mw.Elastic(E, NU, RHO)
+    for dtype in ("float32", "float64"):
+        a = uniaxial_tension(cracking(), 0.8 * ST / E, n=50, dtype=dtype)
+        b = uniaxial_tension(el, 0.8 * ST / E, n=50, dtype=dtype)
+        np.testing.assert_array_equal(a["stress"], b["stress"])
+        assert np.all(a["kappa"] == 0.0)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_engine_block_below_its_strength_matches_the_elastic_block(dim):
+    def block(mat):
+        lo, hi = (0.0,) * dim, (0.2, 0.1) + (0.04,) * (dim - 2)
+        # a block resting on a slip floor and sliding along it: self-weight stresses, far below the strength
+        sc = mw.Scenario(name="b", domain=mw.Domain(lo=(-0.05, 0.0) + (-0.05,) * (dim - 2),
+                                                     hi=(0.25, 0.15) + (0.09,) * (dim - 2), dx=0.01,
+                                                     boundary="slip", dimension=dim),
+                         time=mw.TimeControl(end=0.02, frame_interval=0.02), materials={"m": mat},
+                         blocks=(mw.Block("m", lo, hi, velocity=(0.3,) + (0.0,) * (dim - 1)),))
+        sim = mw.Simulation(sc, device="cpu")
+        sim.step_to(0.02)
+        return sim
+    a, b = block(cracking(tensile_strength=1e6, fracture_energy=1e3, band_width=1e-3)), block(mw.Elastic(E, NU, RHO))
+    assert np.abs(a.particle_field("stress")).max() > 50.0        # it is loaded
+    np.testing.assert_array_equal(a.state.x.numpy(), b.state.x.numpy())
+    np.testing.assert_array_equal(a.state.H.numpy(), b.state.H.numpy())
+    assert np.all(a.state.kappa.numpy() == 0.0) and b.state.kappa is None
+
+
+def test_a_band_wider_than_the_snap_back_limit_is_refused():
+    mat = cracking()
+    limit = 2 * E * GF / ST**2
+    assert mat.max_band_width == pytest.approx(limit)
+    with pytest.raises(InvalidArgument, match=r"band_width = 0.1 .*narrower than 2 E G_f / sigma_t\^2 = 0.08 m"):
+        cracking(band_width=0.1).validate("slab")
+    with pytest.raises(InvalidArgument, match="tensile_strength"):
+        cracking(tensile_strength=0.0).validate()
+
+
+def test_plane_strain_softens_the_in_plane_stress_as_3d_does():
+    # stretch along x with y stress-free and z fixed: the 2D kernels against the 3D ones (the out-of-plane stress
+    # tau_zz = lam tr(eps) is not softened in 2D, where it does not act on the grid; the in-plane path is the same)
+    mat = cracking()
+    n = 300
+    ex = np.linspace(1.2 * mat.failure_stress / E / n, 1.2 * mat.failure_stress / E, n)
+    F3 = np.tile(np.eye(3), (n, 1, 1))
+    F3[:, 0, 0] = np.exp(ex)
+    F2 = F3[:, :2, :2].copy()
+    a = drive_material_points(F_total=F3, material=mat, dtype="float64", stress_tol=1e-6,
+                              stress_control={"axes": (False, True, False), "sigma": (0.0, 0.0, 0.0)})
+    b = drive_material_points(F_total=F2, material=mat, dtype="float64", stress_tol=1e-6,
+                              stress_control={"axes": (False, True), "sigma": (0.0, 0.0)})
+    assert a["damage"][0, -1] == 1.0 and b["damage"][0, -1] == 1.0
+    np.testing.assert_allclose(b["stress"][0, :, 0, 0], a["stress"][0, :, 0, 0], rtol=1e-6, atol=1e-6 * ST)
+    np.testing.assert_allclose(b["damage"][0], a["damage"][0], rtol=1e-9, atol=1e-12)
