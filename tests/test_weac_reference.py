@@ -249,6 +249,7 @@ def test_bad_arguments_are_refused_in_one_line():
                         (lambda: wr.energy_release_rate(column(), -0.1), "cut"),
                         (lambda: wr.critical_cut(column(), 0.0), "G_c"),
                         (lambda: wr.slab_stress(column(), 0.3, strengths=[1e3, 2e3]), "strengths"),
+                        (lambda: wr.slab_stress(column(), 0.3, strengths=1e3), "strengths"),
                         (lambda: wr.slab_stress(column(), 0.3, dx=0.0), "dx")):
         with pytest.raises(InvalidArgument) as err:
             call()
@@ -276,7 +277,7 @@ def test_without_weac_every_call_says_so_in_one_line(monkeypatch):
     assert str(err.value) == wr.NOT_INSTALLED
 
 
-@pytest.mark.parametrize("version", ["3.3.1", "2.5.0"])
+@pytest.mark.parametrize("version", ["3.3.1", "2.5.0", "3"])
 def test_another_weac_api_is_refused_in_one_line(monkeypatch, version):
     monkeypatch.setattr(wr._md, "version", lambda name: version)
     why = wr.weac_unavailable()

@@ -48,7 +48,7 @@ def weac_unavailable() -> str | None:
     v = weac_version()
     if v is None:
         return NOT_INSTALLED
-    parts = tuple(int(p) for p in re.findall(r"\d+", v)[:2])
+    parts = tuple(int(p) for p in (re.findall(r"\d+", v) + ["0", "0"])[:2])
     if not _SUPPORTED[0] <= parts < _SUPPORTED[1]:
         return (f"weac {v} is installed, but mpm_warp speaks the weac 2.6.x API (weac 3 has another one): "
                 "pip install 'weac>=2.6,<3' (Python >= 3.10)")
@@ -300,7 +300,8 @@ def slab_stress(column: StaticColumn, cut: float, strengths=None, *, dx: float =
     dx = finite_number("dx", dx, lo=0.0, lo_open=True)
     dz = finite_number("dz", dz, lo=0.0, lo_open=True)
     if strengths is not None:
-        if isinstance(strengths, (str, bytes)) or len(strengths) != len(column.slab):
+        if isinstance(strengths, (str, bytes)) or not hasattr(strengths, "__len__") or len(strengths) != len(
+                column.slab):
             raise InvalidArgument("strengths", strengths, f"{len(column.slab)} tensile strengths (Pa), top to bottom")
         strengths = np.array([finite_number(f"strengths[{i}]", s, lo=0.0, lo_open=True)
                               for i, s in enumerate(strengths)])
