@@ -19,7 +19,6 @@ from mpm_warp.errors import InvalidArgument
 from mpm_warp.scenes import weac_reference as wr
 from mpm_warp.scenes.snow import GRAVITY
 
-needs_weac = pytest.mark.skipif(wr.weac_unavailable() is not None, reason=str(wr.weac_unavailable()))
 W_F = 0.79                                     # J/m^2: the ladder PST's fracture energy, G_c of the energy criterion
 
 
@@ -53,7 +52,6 @@ MIRRORED = [((0.0, "upslope", "slope_normal"), ("pst-", 0.0)), ((30.0, "upslope"
             ((35.0, "downslope", "vertical"), ("-vpst", 35.0))]
 
 
-@needs_weac
 @pytest.mark.parametrize("ours, theirs", MIRRORED)
 def test_energy_release_rate_is_a_direct_weac_call(ours, theirs):
     got = wr.energy_release_rate(column(*ours), 0.31)
@@ -62,7 +60,6 @@ def test_energy_release_rate_is_a_direct_weac_call(ours, theirs):
     assert got[0] == pytest.approx(got[1] + got[2], rel=1e-12)
 
 
-@needs_weac
 @pytest.mark.parametrize("ours, theirs", MIRRORED[:3])
 def test_critical_cut_is_the_root_of_a_direct_weac_call(ours, theirs):
     from scipy.optimize import brentq
@@ -71,7 +68,6 @@ def test_critical_cut_is_the_root_of_a_direct_weac_call(ours, theirs):
     assert wr.critical_cut(column(*ours), W_F) == pytest.approx(want, rel=1e-6)
 
 
-@needs_weac
 def test_critical_cuts_match_weac_3_3_1_for_the_ladder_pst():
     """Issue 21's independent values (weac 3.3.1): flat 0.380 m, 30 deg from downslope 0.382 m, upslope 0.452 m."""
     assert round(wr.critical_cut(column(0.0), W_F), 3) == 0.380
@@ -88,7 +84,6 @@ def _tip(col, cut):
     return s.model.N(z)[0], s.model.V(z)[0], s.model.M(z)[0]
 
 
-@needs_weac
 @pytest.mark.parametrize("theta", [20.0, 30.0])
 def test_the_cut_slab_carries_its_own_weight_downslope(theta):
     """Statics of the free slab over the cut: its downslope weight ``q a sin(theta)`` pushes on the intact slab when
@@ -103,7 +98,6 @@ def test_the_cut_slab_carries_its_own_weight_downslope(theta):
         assert abs(M) == pytest.approx(q * math.cos(th) * (a * 1e3) ** 2 / 2.0, rel=1e-6)
 
 
-@needs_weac
 def test_vertical_ends_add_the_upslope_wedge_and_remove_the_downslope_one():
     """Plumb ends on a slope: the slab overhangs the upslope end by a wedge of weight ``rho g H^2 tan(theta) / 2``
     and lacks that wedge at the downslope end; the cut slab's section force at the tip says so."""
@@ -122,7 +116,6 @@ def test_vertical_ends_add_the_upslope_wedge_and_remove_the_downslope_one():
     assert g_up_v > g_up_n and g_dn_v < g_dn_n
 
 
-@needs_weac
 def test_the_downslope_weight_opens_a_cut_from_the_downslope_end():
     """The downslope pull ``N`` on the cut slab acts at its mid-plane, above the weak layer that holds it: from the
     downslope end it bends the free slab further down (more mode I than the slope-normal load alone, which is the
@@ -133,7 +126,6 @@ def test_the_downslope_weight_opens_a_cut_from_the_downslope_end():
     assert down > 1.1 * flat * math.cos(math.radians(30.0)) ** 2 > 1.1 * up
 
 
-@needs_weac
 def test_mirror_and_flat_symmetries():
     for ends in ("slope_normal", "vertical"):
         for cut_from in ("upslope", "downslope"):
@@ -144,7 +136,6 @@ def test_mirror_and_flat_symmetries():
         assert wr.energy_release_rate(column(0.0, cut_from, ends), 0.3) == pytest.approx(flat, rel=1e-9)
 
 
-@needs_weac
 def test_weac_uses_the_given_E_and_nu_not_its_density_law():
     slab = [(0.1, 150.0, 1.0e6, 0.2), (0.15, 250.0, 8.0e6, 0.3), (0.05, 300.0, 20.0e6, 0.25)]
     m = wr._model(column(slab=slab))
@@ -178,7 +169,6 @@ FIELDS = [((0.0, "upslope", "slope_normal"), ("pst-", 0.0)), ((30.0, "upslope", 
           ((30.0, "downslope", "slope_normal"), ("pst-", -30.0))]
 
 
-@needs_weac
 @pytest.mark.parametrize("ours, theirs", FIELDS)
 def test_slab_stress_raw_is_weacs_principal_stress(ours, theirs):
     st = wr.slab_stress(column(*ours), 0.452, strengths=[wr.sigrist_tensile_strength(250.0)], raw_weac=True)
@@ -193,7 +183,6 @@ def test_slab_stress_raw_is_weacs_principal_stress(ours, theirs):
     assert st["depth"][0] == 0.0 and st["depth"][-1] == pytest.approx(0.3)
 
 
-@needs_weac
 def test_slab_stress_over_the_cut_has_a_free_base():
     """Over the cut nothing holds the slab's base: there ``tau_xz = sigma_zz = 0`` and the tensile principal stress
     is the axial stress where that pulls. weac 2.6's raw field (weak-layer equations there too) is not."""
@@ -210,7 +199,6 @@ def test_slab_stress_over_the_cut_has_a_free_base():
     assert np.array_equal(st["sigma_1"][:, ~free], raw["sigma_1"][:, ~free])
 
 
-@needs_weac
 def test_slab_stress_layers_and_strengths():
     slab = [(0.1, 150.0, 1.0e6, 0.25), (0.2, 300.0, 10.0e6, 0.25)]
     st = wr.slab_stress(column(slab=slab), 0.3, strengths=[1.0e3, 2.0e3])
@@ -243,7 +231,6 @@ def test_a_bad_column_is_refused_in_one_line_naming_the_field(change, field):
     assert err.value.field == field and "\n" not in str(err.value)
 
 
-@needs_weac
 def test_bad_arguments_are_refused_in_one_line():
     for call, field in ((lambda: wr.energy_release_rate(column(), 2.2), "cut"),
                         (lambda: wr.energy_release_rate(column(), -0.1), "cut"),
@@ -256,7 +243,6 @@ def test_bad_arguments_are_refused_in_one_line():
         assert err.value.field == field
 
 
-@needs_weac
 def test_critical_cut_none_when_G_stays_below_G_c():
     res = wr.critical_cut_search(column(), W_F, max_cut=0.3)      # a_c = 0.380 m lies beyond the saw
     assert res.value is None and "G < G_c" in res.reason and wr.critical_cut(column(), W_F, max_cut=0.3) is None
