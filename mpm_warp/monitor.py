@@ -10,7 +10,8 @@ with :meth:`mpm_warp.Simulation.add_monitor`; the engine then, without knowing w
   (:meth:`Monitor.particle_fields`, :meth:`Monitor.particle_field`) in every frame;
 - stores :meth:`Monitor.state` in every checkpoint (under ``monitors/<name>/``) and hands it back to
   :meth:`Monitor.load_state` on resume, so a resumed run continues exactly;
-- puts :meth:`Monitor.result` into :attr:`mpm_warp.RunResult.scene_result` when a run ends.
+- puts :meth:`Monitor.result` into :attr:`mpm_warp.RunResult.scene_result` when a run ends, and an optional
+  ``outcome()`` record (how the run ended, a few values) into the run file's ``outcome`` attribute.
 
 A monitor reads and writes particles only through :meth:`mpm_warp.Simulation.group_state`
 (array views of one particle group, :class:`GroupState`) and the device clock
@@ -54,6 +55,9 @@ class Monitor(Protocol):
 
     def result(self) -> dict:
         """Results of the run so far (named numbers), e.g. a crack speed."""
+
+    # optional: ``outcome() -> dict``, a short record of how the run ended (a few named values, JSON of at most
+    # 2 KiB), stored in the run file's ``outcome`` attribute when a run ends, e.g. a PST's class and field line
 
 
 @dataclass

@@ -376,7 +376,13 @@ class Simulation:
         finally:
             self._stop_now = False
             if writer is not None:
-                writer.close()
+                try:
+                    outcomes = {n: m.outcome() for n, m in self.monitors.items()
+                                if callable(getattr(m, "outcome", None))}
+                    if outcomes:
+                        writer.set_outcome(outcomes)
+                finally:
+                    writer.close()
         n = self.model.n_particles
         result = {}
         for m in self.monitors.values():

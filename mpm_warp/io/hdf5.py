@@ -28,7 +28,10 @@ def series_chunk(row_bytes: int) -> int:
     """Frames per chunk of a small per-frame series: the most whose chunk, with its 4-byte Fletcher-32
     checksum, fits in one :data:`PAGE` (a chunk is rewritten in place at every frame until it is full)."""
     return max(1, (PAGE - 4) // max(1, int(row_bytes)))
-RESERVED_ATTRS = {"format", "format_version", "created", "n_particles", "json_attrs"}
+RESERVED_ATTRS = {"format", "format_version", "created", "n_particles", "json_attrs", "outcome"}
+#: bytes reserved for the ``outcome`` attribute (a fixed-size string rewritten in place when a run ends: within one
+#: page, so a kill during that write cannot tear it across two)
+OUTCOME_BYTES = 2048
 COMPRESSION = {"gzip": dict(compression="gzip", compression_opts=1, shuffle=True),
                 "lzf": dict(compression="lzf", shuffle=True), "none": {}}
 
@@ -58,8 +61,13 @@ def set_attrs(obj, attrs: dict) -> None:
 def get_attrs(obj) -> dict:
     as_json = set(json.loads(obj.attrs.get("json_attrs", "[]")))
     out = {k: json.loads(v) if k in as_json else v.item() if isinstance(v, np.generic) else v
-           for k, v in obj.attrs.items()}
+           for k, v in obj.attrs.items() if k != "outcome"}
     out.pop("json_attrs", None)
+    if "outcome" in obj.attrs:
+        try:
+            out["outcome"] = json.loads(bytes(obj.attrs["outcome"]).rstrip(b" \0").decode() or "{}")
+        except (ValueError, UnicodeDecodeError):
+            out["outcome"] = {}
     return out
 
 

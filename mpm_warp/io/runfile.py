@@ -66,6 +66,7 @@ from .hdf5 import (
     FORMAT,
     FORMAT_VERSION,
     LIBVER,
+    OUTCOME_BYTES,
     PAGE,
     RESERVED_ATTRS,
     check_format,
@@ -217,6 +218,7 @@ class RunWriter:
                         "numpy": np.__version__} | (attrs.get("versions") or {})
             units = {"length": "m", "time": "s", "mass": "kg", "force": "N", "energy": "J"}
             set_attrs(f, {**attrs, "versions": versions, "units": units | (attrs.get("units") or {})})
+            f.attrs.create("outcome", np.bytes_(b"{}".ljust(OUTCOME_BYTES)), dtype=f"S{OUTCOME_BYTES}")
             n, filt = self.n_particles, COMPRESSION[compression]
 
             def series(name, dtype, unit, shape=(), chunk=None, **kw):
@@ -327,6 +329,15 @@ class RunWriter:
         self._f.flush()
         self._n = n + 1
         return n
+
+    def set_outcome(self, outcome: dict) -> None:
+        """Store how the run ended (JSON of at most :data:`~mpm_warp.io.hdf5.OUTCOME_BYTES` bytes) in the root
+        ``outcome`` attribute, rewritten in place; read back by :attr:`mpm_warp.io.RunData.attrs`."""
+        text = json.dumps(outcome, allow_nan=True, default=float).encode()
+        if len(text) > OUTCOME_BYTES:
+            raise InvalidArgument("outcome", f"{len(text)} bytes of JSON", f"at most {OUTCOME_BYTES} bytes")
+        self._f.attrs.modify("outcome", np.bytes_(text.ljust(OUTCOME_BYTES)))
+        self._f.flush()
 
     def close(self) -> None:
         """Trim a partly written frame (left by an exception) and close the file."""

@@ -47,11 +47,16 @@ class Slab:
         Poisson's ratio (-), in [0, 0.5).
     density : float
         Density (kg/m^3), > 0.
+    tensile_strength, fracture_energy : float
+        Of a slab that can break (Pa, J/m^2), >= 0; 0 = from the density (``scene.slab_fracture``; see
+        :class:`~mpm_warp.scenes.snowpack.SnowLayer`). Unused for the substratum.
     """
 
     E: float = 5.0e6
     nu: float = 0.3
     density: float = 250.0
+    tensile_strength: float = 0.0
+    fracture_energy: float = 0.0
 
     def material(self) -> Elastic:
         """The slab's elastic material (checked, naming ``where`` in errors)."""
@@ -60,6 +65,8 @@ class Slab:
     def validate(self, where: str = "slab") -> Slab:
         """Check every value; return self."""
         self.material().validate(where)
+        finite_number(f"{where}.tensile_strength", self.tensile_strength, lo=0.0)
+        finite_number(f"{where}.fracture_energy", self.fracture_energy, lo=0.0)
         return self
 
 

@@ -11,12 +11,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..checks import finite_number
 from ..errors import InvalidArgument
+from ..materials import CrackingSnow
 from .snow import Slab, slab_normal_stress
 
-__all__ = ["SnowLayer", "RHO_ICE", "bergfeld_modulus", "stack_thickness", "stack_normal_stress",
-           "equivalent_slab", "check_stack"]
+__all__ = ["SnowLayer", "RHO_ICE", "bergfeld_modulus", "sigrist_tensile_strength", "fracture_toughness",
+           "stack_thickness", "stack_normal_stress", "equivalent_slab", "check_stack"]
 
 #: density of ice (kg/m^3) in the density laws (the value weac uses in its modulus law)
 RHO_ICE = 916.7
@@ -29,6 +32,24 @@ def bergfeld_modulus(density: float) -> float:
     (250 kg/m^3 gives 21.4 MPa, 150 kg/m^3 2.26 MPa).
     """
     return 6.5e9 * (float(density) / RHO_ICE) ** 4.4
+
+
+def sigrist_tensile_strength(density):
+    """Tensile strength of snow from its density (Pa): ``240 kPa (rho / 917)^2.44`` (Sigrist 2006; the law weac
+    uses). Float or array."""
+    return 2.4e5 * (np.asarray(density, dtype=float) / 917.0) ** 2.44 if np.ndim(density) else \
+        2.4e5 * (float(density) / 917.0) ** 2.44
+
+
+def fracture_toughness(density: float) -> float:
+    """Mode-I fracture toughness of snow from its density (Pa m^1/2): ``750 (rho / 200)^2``.
+
+    Schweizer, Michot and Kirchner (2004, Ann. Glaciol. 38) measured ``K_Ic`` with notched cantilever beams at
+    100-300 kg/m^3: typically 500-1000 Pa m^1/2, growing with relative density with an exponent of about 2. This
+    law takes their exponent and the middle of their typical range at 200 kg/m^3 (docs/model.md §9); the fracture
+    energy of a layer is then ``K_Ic^2 (1 - nu^2) / E`` (plane strain).
+    """
+    return 750.0 * (float(density) / 200.0) ** 2
 
 
 @dataclass(frozen=True)
@@ -64,13 +85,32 @@ class SnowLayer:
     name: str = ""
 
     @property
+    def strength(self) -> float:
+        """Tensile strength (Pa): ``tensile_strength``, or :func:`sigrist_tensile_strength` of the density."""
+        return float(self.tensile_strength) if self.tensile_strength > 0.0 else sigrist_tensile_strength(self.density)
+
+    @property
+    def toughness_energy(self) -> float:
+        """Mode-I fracture energy (J/m^2): ``fracture_energy``, or ``K_Ic^2 (1 - nu^2) / E`` with
+        :func:`fracture_toughness` of the density."""
+        if self.fracture_energy > 0.0:
+            return float(self.fracture_energy)
+        return fracture_toughness(self.density) ** 2 * (1.0 - self.nu**2) / self.modulus
+
+    def cracking(self, band_width: float) -> CrackingSnow:
+        """The layer as a slab that can break, its crack band ``band_width`` (m) wide."""
+        return CrackingSnow(self.modulus, self.nu, self.density, tensile_strength=self.strength,
+                            fracture_energy=self.toughness_energy, band_width=float(band_width))
+
+    @property
     def modulus(self) -> float:
         """Young's modulus (Pa): ``E``, or :func:`bergfeld_modulus` of the density when ``E`` is 0."""
         return float(self.E) if self.E > 0.0 else bergfeld_modulus(self.density)
 
     def slab(self) -> Slab:
         """The layer's elastic material as a :class:`~mpm_warp.scenes.snow.Slab` (E resolved)."""
-        return Slab(E=self.modulus, nu=self.nu, density=self.density)
+        return Slab(E=self.modulus, nu=self.nu, density=self.density, tensile_strength=self.tensile_strength,
+                    fracture_energy=self.fracture_energy)
 
     def validate(self, where: str = "layer") -> SnowLayer:
         """Check every value (InvalidArgument naming ``where.field``); return self."""

@@ -15,7 +15,7 @@ from ..fronts import front_trajectory, lead_ahead_of_front, mean_speed, speed_pr
 from ..references import heierli_speed, heierli_touchdown
 from .params import PSTParams
 
-__all__ = ["pst_summary", "end_zone", "SPEED_WINDOW", "MEAN_SPEED_DISTANCE", "SPEED_LIMIT_DISTANCE"]
+__all__ = ["pst_summary", "end_zone", "runaway_cut", "SPEED_WINDOW", "MEAN_SPEED_DISTANCE", "SPEED_LIMIT_DISTANCE"]
 
 #: window of the local front speed (m)
 SPEED_WINDOW = 0.5
@@ -45,7 +45,7 @@ def _front(params: PSTParams, s, t_arrival, prefix: str) -> dict:
             f"{prefix}_path": {"s": sp.tolist(), "t": T.tolist()}}
 
 
-def _runaway(params: PSTParams, s, t_arrival) -> float:
+def runaway_cut(params: PSTParams, s, t_arrival) -> float:
     """Saw position (m) when the damage front first led the blade by ``front.runaway_lead``; nan if never."""
     sp, T = front_trajectory(s, t_arrival)
     saw = np.clip(params.saw.speed * (T - params.saw_start), 0.0, params.saw.cut_length)
@@ -100,7 +100,7 @@ def pst_summary(params: PSTParams, calibration, times, series: dict, s_bins, t_d
     out["speed"] = out["damage_speed_mean"]
     v1, v2 = out["damage_speed_mean"], out["deflection_speed_mean"]
     out["front_agreement"] = v2 / v1 if np.isfinite(v1) and np.isfinite(v2) and v1 > 0 else math.nan
-    out["runaway_cut"] = _runaway(params, s_bins, t_damage)
+    out["runaway_cut"] = runaway_cut(params, s_bins, t_damage)
     out["max_damage_lead"], out["max_damage_lead_at"] = lead_ahead_of_front(s_bins, t_damage)
     t = np.asarray(times, dtype=float)
     df = np.asarray(series.get("deflection_front", np.zeros(len(t))), dtype=float)

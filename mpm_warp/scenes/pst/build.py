@@ -62,8 +62,9 @@ def build(params: PSTParams, time: TimeControl, output: Output | None = None, *,
         y += layer.thickness
     add("weak_layer", cal.material, y, y + d_wl)
     y += d_wl
-    for group, layer in reversed(list(zip(layer_names("slab", len(slab)), slab, strict=True))):
-        add(group, layer.slab().material(), y, y + layer.thickness)
+    for group, layer, material in reversed(list(zip(layer_names("slab", len(slab)), slab, p.slab_materials(),
+                                                    strict=True))):
+        add(group, material, y, y + layer.thickness)
         y += layer.thickness
     # blocks in the order of old: substratum, weak layer, slab (bottom to top)
     friction = float(p.bed_friction) if p.bed == "separate" else 0.0

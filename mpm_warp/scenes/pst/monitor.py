@@ -8,9 +8,10 @@ import warp as wp
 from ..fronts import front_from_arrival, touchdown_distance
 from ..series import SeriesMonitor, entries_below
 from ..weak_layer import ReferenceField, WeakLayerTracker, bin_median, stored_calibration
-from .analysis import end_zone, pst_summary
+from .analysis import end_zone, pst_summary, runaway_cut
 from .build import layer_names
 from .kernels import deflection_kernel
+from .outcome import SlabCrackDetector, classify
 from .params import PSTParams
 
 __all__ = ["PSTMonitor", "attach"]
@@ -75,6 +76,9 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
             dz = np.abs(x0[base, 2] - zmid)
             zsel = base[dz <= dz.min() + 1e-6]
         self.marker_index = zsel[np.argmin(np.abs(x0[zsel, 0][None, :] - self.markers[:, None]), axis=1)]
+        #: the slab's through-crack finder (a slab that can break only)
+        slab_groups = [sim.group_state(n) for n in layer_names("slab", len(p.slab_stack()))]
+        self.slab_crack = SlabCrackDetector(p, slab_groups) if p.slab_fracture else None
 
     # ----------------------------------------------------------------- contract
     def actions(self) -> list:
@@ -84,6 +88,8 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
     def units(self) -> dict[str, str]:
         """Units of the frame scalars."""
         u = {"front": "m", "deflection_front": "m", "saw": "m", "collapse_height": "m", "touchdown": "m"}
+        if self.slab_crack is not None:
+            u["slab_crack"] = "m"
         for k in range(len(self.markers)):
             u[f"marker{k}_ux"] = "m"
             u[f"marker{k}_uy"] = "m"
@@ -97,6 +103,8 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         deflection = self.deflection_front(t)
         out = {"front": self.damage_front(t),
                "deflection_front": deflection, "saw": self.saw_position(t)}
+        if self.slab_crack is not None:
+            out["slab_crack"] = self.slab_crack.through_crack()
         c, sawn = self.weak.collapse()
         gone = (self.weak.bond() <= 0.0) & (sawn == 0) & self.interior
         out["collapse_height"] = float(np.mean(c[gone]) * p.weak_layer_thickness) if gone.any() else 0.0
@@ -124,8 +132,17 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
     def result(self) -> dict:
         """Scene results from the series and arrival times so far (:func:`.analysis.pst_summary`)."""
         times, series = self.series_arrays()
-        return pst_summary(self.params, self.calibration, times, series, self.bin_centres(), self.damage_arrival(),
-                           self.deflection_arrival())
+        out = pst_summary(self.params, self.calibration, times, series, self.bin_centres(), self.damage_arrival(),
+                          self.deflection_arrival())
+        out["outcome"] = classify(self.params, times, series.get("front", []), series.get("slab_crack"),
+                                  out["runaway_cut"])
+        return out
+
+    def outcome(self) -> dict:
+        """How the run ended, as the field writes it (:func:`~.outcome.classify`): stored in the run file."""
+        times, series = self.series_arrays()
+        runaway = runaway_cut(self.params, self.bin_centres(), self.damage_arrival())
+        return classify(self.params, times, series.get("front", []), series.get("slab_crack"), runaway)
 
     # ------------------------------------------------------------------ queries
     def bin_centres(self) -> np.ndarray:

@@ -120,6 +120,10 @@ class PSTParams:
         The parts (:class:`~mpm_warp.scenes.snow.Slab` twice: a homogeneous slab of ``slab_thickness`` and
         the old snow of ``substratum_thickness`` under the weak layer; :class:`~mpm_warp.scenes.weak_layer.
         WeakLayer`, :class:`~mpm_warp.scenes.snow.Settle`, :class:`Saw`, :class:`Front`).
+    slab_fracture : bool
+        The slab can break: each slab layer cracks in tension (:class:`~mpm_warp.materials.CrackingSnow`) at its
+        tensile strength and fracture energy (given, or from its density), over a crack band of one particle
+        spacing, ``dx / particles_per_cell``. False (the default): an elastic slab, at no extra cost.
     slab_layers, substratum_layers : tuple of SnowLayer
         A layered slab or substratum, top to bottom (:class:`~mpm_warp.scenes.snowpack.SnowLayer`; an
         omitted E comes from the density). Given, they replace ``slab``/``slab_thickness`` (or
@@ -149,6 +153,7 @@ class PSTParams:
     front: Front = field(default_factory=Front)
     slab_layers: tuple[SnowLayer, ...] = ()
     substratum_layers: tuple[SnowLayer, ...] = ()
+    slab_fracture: bool = False
 
     def validate(self, where: str = "scene") -> PSTParams:
         """Check every value (InvalidArgument naming ``where.field``, the value and the range); return self."""
@@ -163,6 +168,10 @@ class PSTParams:
         for part in ("slab", "substratum"):
             self._check_layers(part, where)
         finite_number(f"{where}.substratum_thickness (of the layers)", self.substratum_depth, lo=2.0 * dx)
+        if not isinstance(self.slab_fracture, bool):
+            raise InvalidArgument(f"{where}.slab_fracture", self.slab_fracture, "true or false")
+        if self.slab_fracture:
+            self._check_crack_band(where)
         finite_number(f"{where}.slope_angle", self.slope_angle, lo=-60.0, hi=60.0)
         finite_number(f"{where}.width", self.width, lo=0.0)
         check_plane_strain(self.plane_strain, self.width, where)
@@ -194,6 +203,27 @@ class PSTParams:
                 raise InvalidArgument(f"{where}.{name}", getattr(self, name),
                                       f"left out when {where}.{part}_layers are given (the layers define the {part})")
 
+    @property
+    def crack_band(self) -> float:
+        """Width of the band a slab crack localises in (m): one particle spacing, ``dx / particles_per_cell``
+        (measured: a bar pulled apart cracks along one particle row, docs/model.md §9)."""
+        return self.dx / self.particles_per_cell
+
+    def slab_materials(self) -> list:
+        """The slab layers' materials, top to bottom: elastic, or cracking with ``slab_fracture``."""
+        return [layer.cracking(self.crack_band) if self.slab_fracture else layer.slab().material()
+                for layer in self.slab_stack()]
+
+    def _check_crack_band(self, where: str) -> None:
+        for i, layer in enumerate(self.slab_stack()):
+            mat = layer.cracking(self.crack_band)
+            name = f"{where}.slab_layers[{i}]" if self.slab_layers else f"{where}.slab"
+            if self.crack_band >= mat.max_band_width:
+                raise InvalidArgument(f"{where}.dx", self.dx, (
+                    f"a spacing whose crack band dx/particles_per_cell stays below 2 E G_f / sigma_t^2 = "
+                    f"{mat.max_band_width:.3g} m for {name} (sigma_t {mat.tensile_strength:.4g} Pa, G_f "
+                    f"{mat.fracture_energy:.3g} J/m^2): wider, its softening snaps back"))
+
     def to_dict(self) -> dict:
         """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back)."""
         return asdict(self)
@@ -201,7 +231,9 @@ class PSTParams:
     # ------------------------------------------------------------- the snowpack
     def slab_stack(self) -> tuple[SnowLayer, ...]:
         """The slab's layers, top to bottom (one layer of ``slab`` and ``slab_thickness`` unless layered)."""
-        return self.slab_layers or (SnowLayer(self.slab_thickness, self.slab.density, self.slab.E, self.slab.nu),)
+        s = self.slab
+        return self.slab_layers or (SnowLayer(self.slab_thickness, s.density, s.E, s.nu, s.tensile_strength,
+                                              s.fracture_energy),)
 
     def substratum_stack(self) -> tuple[SnowLayer, ...]:
         """The substratum's layers, top to bottom."""

@@ -1,0 +1,144 @@
+"""The outcome of a PST as the field writes it: END, SF or ARR, and the line ``PST 32/100 (END) down 50 cm``.
+
+The field's three classes (e.g. Greene et al., SWAG; Gauthier and Jamieson 2008):
+
+- END: the crack in the weak layer reached the far end of the column;
+- SF: the slab fractured through before that;
+- ARR: the crack arrested in the weak layer (here also a crack that never ran beyond the saw).
+
+A through-crack of the slab (:class:`SlabCrackDetector`): in a window one slab thickness wide along the
+column, the fully damaged slab particles (damage >= :data:`THROUGH_DAMAGE`) cover at least
+:data:`THROUGH_COVER` of the slab's particle rows, top to bottom. The crack reached the far end when the
+damage front entered the end zone (one slab thickness from the far end, as the front speeds).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .analysis import end_zone
+from .params import PSTParams
+
+__all__ = ["SlabCrackDetector", "classify", "field_line", "THROUGH_DAMAGE", "THROUGH_COVER", "STALL_TIME"]
+
+#: damage (-) at which a slab particle is cracked through
+THROUGH_DAMAGE = 0.95
+#: fraction of the slab's particle rows a through-crack covers (-)
+THROUGH_COVER = 0.9
+#: a front that has not advanced for this long (s) at the end of a run has arrested
+STALL_TIME = 0.05
+
+
+class SlabCrackDetector:
+    """Finds a crack through the slab from its particles' damage (host side, once per frame).
+
+    Parameters
+    ----------
+    params : PSTParams
+    groups : list of GroupState
+        The slab layers' particle groups (cracking materials).
+    """
+
+    def __init__(self, params: PSTParams, groups):
+        self.params = params
+        self.groups = groups
+        x0 = np.concatenate([g.x0 for g in groups])
+        s = params.distance_from_cut_end(x0[:, 0])
+        w = params.bin_width
+        self.bins = np.clip((s / w).astype(int), 0, params.n_bins - 1)
+        rows = np.unique(np.round(x0[:, 1], 9))
+        self.rows = np.searchsorted(rows, np.round(x0[:, 1], 9))
+        self.n_rows = len(rows)
+        #: window of bins a through-crack may lean over (one slab thickness)
+        self.window = max(1, int(round(params.slab_depth / w)))
+
+    def damage(self) -> np.ndarray:
+        """Damage (-) of the slab's particles, in the order of :attr:`groups`."""
+        return np.concatenate([g.material.damage(g.kappa.numpy()) for g in self.groups])
+
+    def through_crack(self) -> float:
+        """Position (m from the cut end) of the first crack through the slab, nan if there is none."""
+        cracked = self.damage() >= THROUGH_DAMAGE
+        if not cracked.any():
+            return math.nan
+        nb = self.params.n_bins
+        hit = np.zeros((nb + 1, self.n_rows), dtype=np.int32)
+        hit[self.bins[cracked] + 1, self.rows[cracked]] = 1
+        c = np.cumsum(hit, axis=0)                         # rows cracked in bins [0, b)
+        k = self.window
+        lo = np.clip(np.arange(nb) - k // 2, 0, nb)
+        hi = np.clip(np.arange(nb) + (k - k // 2), 0, nb)
+        cover = ((c[hi] - c[lo]) > 0).mean(axis=1)        # rows cracked within the window around each bin
+        through = np.nonzero(cover >= THROUGH_COVER)[0]
+        if not len(through):
+            return math.nan
+        return float(min((through[0] + 0.5) * self.params.bin_width, self.params.length))
+
+
+def field_line(cls: str | None, cut: float, length: float, depth: float) -> str:
+    """The observer's line, e.g. ``PST 32/100 (END) down 50 cm``: cut and column length and the weak layer's depth
+    (slope-normal, below the surface) in whole centimetres."""
+    c = cls if cls is not None else "running"
+    return f"PST {round(100 * cut):d}/{round(100 * length):d} ({c}) down {round(100 * depth):d} cm"
+
+
+def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | None = None) -> dict:
+    """The field class of a PST run from its frame series (``times`` s; ``front``, ``slab_crack`` m from the cut end).
+
+    Parameters
+    ----------
+    params : PSTParams
+    times, front : array (n,)
+        Frame times (s) and the damage front (m from the cut end).
+    slab_crack : array (n,), optional
+        Position of a through-crack of the slab per frame (m, nan: none); None for a slab that cannot break.
+    saw_cut : float, optional
+        The cut the field line quotes (m): the saw's position when the crack ran away from it (the run's
+        ``runaway_cut``) or, when it never did, the cut made (``saw.cut_length``).
+
+    Returns
+    -------
+    dict
+        ``class`` ("END", "SF", "ARR", or None while the crack still runs when the series ends),
+        ``field_line`` (:func:`field_line`), ``cut``, ``column_length``, ``depth`` (m), ``end_time``,
+        ``slab_fracture_time`` (s, nan: never), ``slab_fracture_at`` (m from the cut end, nan), ``arrest_at``
+        (m from the cut end for ARR, nan otherwise), ``note``.
+    """
+    t = np.asarray(times, dtype=float)
+    fr = np.asarray(front, dtype=float)
+    L, D = float(params.length), float(params.slab_depth)
+    cut = float(params.saw.cut_length) if saw_cut is None or not math.isfinite(saw_cut) else float(saw_cut)
+    reach_end = np.nonzero(fr >= L - end_zone(params))[0]
+    t_end = float(t[reach_end[0]]) if len(reach_end) else math.nan
+    sc = np.full(len(t), np.nan) if slab_crack is None else np.asarray(slab_crack, dtype=float)
+    broke = np.nonzero(np.isfinite(sc))[0]
+    t_sf = float(t[broke[0]]) if len(broke) else math.nan
+    at_sf = float(sc[broke[0]]) if len(broke) else math.nan
+    out = {"cut": cut, "column_length": L, "depth": D, "end_time": t_end, "slab_fracture_time": t_sf,
+           "slab_fracture_at": math.nan, "arrest_at": math.nan, "note": ""}
+    if math.isfinite(t_sf) and not t_end <= t_sf:
+        cls = "SF"
+        out["slab_fracture_at"] = at_sf
+    elif math.isfinite(t_end):
+        cls = "END"
+    elif len(t) and _stalled(t, fr, params):
+        cls = "ARR"
+        out["arrest_at"] = float(fr[-1])
+        if fr[-1] < cut + params.front.runaway_lead:
+            out["note"] = "the crack did not run beyond the saw"
+    else:
+        cls = None
+        out["note"] = "the crack was still running when the run ended (lengthen time.end to classify it)"
+    out["class"] = cls
+    out["field_line"] = field_line(cls, cut, L, D)
+    return out
+
+
+def _stalled(t, front, params: PSTParams) -> bool:
+    """Whether the front has stood still for :data:`STALL_TIME` at the end of the series, after the saw stopped."""
+    if t[-1] < params.saw_end + STALL_TIME:
+        return False
+    recent = t >= t[-1] - STALL_TIME
+    return bool(front[recent].max() - front[recent].min() < params.bin_width)
