@@ -8,7 +8,8 @@ The field's three classes (e.g. Greene et al., SWAG; Gauthier and Jamieson 2008)
 
 A through-crack of the slab (:class:`SlabCrackDetector`): in a window one slab thickness wide along the
 column, the fully damaged slab particles (damage >= :data:`THROUGH_DAMAGE`) cover at least
-:data:`THROUGH_COVER` of the slab's particle rows, top to bottom. The crack reached the far end when the
+:data:`THROUGH_COVER` of the slab's particle rows, top to bottom; it lies at the median position of those
+particles (initial positions) in its best-covered window. The crack reached the far end when the
 damage front entered the end zone (one slab thickness from the far end, as the front speeds).
 """
 
@@ -45,7 +46,7 @@ class SlabCrackDetector:
         self.params = params
         self.groups = groups
         x0 = np.concatenate([g.x0 for g in groups])
-        s = params.distance_from_cut_end(x0[:, 0])
+        s = self.s = params.distance_from_cut_end(x0[:, 0])
         w = params.bin_width
         self.bins = np.clip((s / w).astype(int), 0, params.n_bins - 1)
         rows = np.unique(np.round(x0[:, 1], 9))
@@ -74,7 +75,11 @@ class SlabCrackDetector:
         through = np.nonzero(cover >= THROUGH_COVER)[0]
         if not len(through):
             return math.nan
-        return float(min((through[0] + 0.5) * self.params.bin_width, self.params.length))
+        # the first through-crack: its best-covered window, and the median position of its cracked particles
+        run = through[: int(np.argmax(np.diff(np.append(through, nb + 2)) > 1)) + 1]
+        b = int(run[np.argmax(cover[run])])
+        near = cracked & (np.abs(self.bins - b) <= k // 2)
+        return float(np.median(self.s[near]))
 
 
 def field_line(cls: str | None, cut: float, length: float, depth: float) -> str:

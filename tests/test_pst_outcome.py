@@ -1,0 +1,102 @@
+"""A PST's outcome as the field writes it: END / SF / ARR and the observer's line (mpm_warp.scenes.pst.outcome)."""
+
+import math
+
+import numpy as np
+import pytest
+
+import mpm_warp as mw
+from mpm_warp.scenes import pst
+from mpm_warp.scenes.pst.outcome import SlabCrackDetector, classify, field_line
+
+#: a soft, thin slab that breaks over the cut: 12 cm of new snow (120 kg/m^3, E 0.85 MPa, Bergfeld et al. 2023;
+#: tensile strength 1.7 kPa, Sigrist 2006) on the default weak layer, a 0.8 m column sawn to 0.5 m at 1 m/s
+SOFT_THIN = ["scene.dx=0.01", "scene.weak_layer_thickness=0.04", "scene.substratum_thickness=0.05",
+             "scene.slab.density=120", "scene.slab.E=0.85e6", "scene.slab_thickness=0.12", "scene.slab_fracture=true",
+             "scene.length=0.8", "scene.saw.cut_length=0.5", "time.end=0.7"]
+
+
+def test_the_observers_line():
+    assert field_line("END", 0.32, 1.0, 0.5) == "PST 32/100 (END) down 50 cm"
+    assert field_line("SF", 0.504, 2.0, 0.2) == "PST 50/200 (SF) down 20 cm"
+    assert field_line(None, 0.3, 1.5, 0.3) == "PST 30/150 (running) down 30 cm"
+
+
+def _series(front_at, t_end=0.8, dt=0.005):
+    t = np.arange(0.0, t_end + 1e-9, dt)
+    return t, np.array([front_at(ti) for ti in t])
+
+
+def test_classes_from_the_series():
+    p = pst.PSTParams(length=2.0, slab_thickness=0.3, saw=pst.Saw(cut_length=0.4))   # saw stops at 0.5 s
+
+    def run(ti):                     # the blade at 1 m/s, then a crack at 20 m/s from 0.45 s on
+        return 0.0 if ti < 0.1 else min(ti - 0.1, 0.4) + max(0.0, ti - 0.45) * 20.0
+    t, fr = _series(lambda ti: min(run(ti), 2.0))
+    end = classify(p, t, fr, None, saw_cut=0.35)
+    assert end["class"] == "END" and end["field_line"] == "PST 35/200 (END) down 30 cm"
+    assert end["end_time"] == pytest.approx(0.45 + (2.0 - 0.3 - 0.35) / 20.0, abs=0.006)
+    # the slab breaks before the front reaches the end zone: SF, where it broke; after it: still END
+    sc = np.where(t >= 0.5, 0.8, np.nan)
+    sf = classify(p, t, fr, sc, saw_cut=0.35)
+    assert sf["class"] == "SF" and sf["slab_fracture_at"] == 0.8 and sf["slab_fracture_time"] == pytest.approx(0.5)
+    late = classify(p, t, fr, np.where(t >= 0.6, 0.8, np.nan), saw_cut=0.35)
+    assert late["class"] == "END" and math.isnan(late["slab_fracture_at"])
+    # a front that stops at 1.2 m and stands still for the last STALL_TIME: ARR there
+    t, fr = _series(lambda ti: min(run(ti), 1.2))
+    arr = classify(p, t, fr, np.full(len(t), np.nan))
+    assert arr["class"] == "ARR" and arr["arrest_at"] == pytest.approx(1.2) and arr["note"] == ""
+    assert arr["cut"] == 0.4            # no runaway: the line quotes the cut made
+    # a crack that never left the saw is an arrest at the blade, said so
+    t, fr = _series(lambda ti: 0.0 if ti < 0.1 else min(ti - 0.1, 0.4))
+    stuck = classify(p, t, fr)
+    assert stuck["class"] == "ARR" and "did not run beyond the saw" in stuck["note"]
+    # a front still moving when the series ends: no class, and why
+    t, fr = _series(lambda ti: min(run(ti), 2.0), t_end=0.47)
+    open_ = classify(p, t, fr)
+    assert open_["class"] is None and "still running" in open_["note"] and "(running)" in open_["field_line"]
+
+
+def test_the_slab_crack_detector_finds_a_through_crack_and_not_a_partial_one():
+    sc = mw.load_scenario("pst_demo", SOFT_THIN)
+    sim = mw.Simulation(sc, device="cpu")
+    mon = pst.attach(sim)
+    det = mon.slab_crack
+    assert isinstance(det, SlabCrackDetector)
+    g = det.groups[0]
+    x0 = g.x0
+    kappa = np.zeros(g.count)
+    y_lo, y_hi = x0[:, 1].min(), x0[:, 1].max()
+    fail = g.material.failure_stress * 1.01
+    # a crack from the top down to 40 % of the slab: not through
+    band = (np.abs(x0[:, 0] - 0.42) < 0.006) & (x0[:, 1] > y_lo + 0.6 * (y_hi - y_lo))
+    kappa[band] = fail
+    g.kappa.assign(kappa.astype(np.float32))
+    assert math.isnan(det.through_crack())
+    # through the whole slab, leaning by 3 cm from top to bottom: found at its median position
+    lean = 0.42 + 0.03 * (x0[:, 1] - y_lo) / (y_hi - y_lo)
+    band = np.abs(x0[:, 0] - lean) < 0.006
+    kappa[:] = 0.0
+    kappa[band] = fail
+    g.kappa.assign(kappa.astype(np.float32))
+    assert det.through_crack() == pytest.approx(np.median(x0[band, 0]), abs=0.005)
+    assert mon.units()["slab_crack"] == "m"
+    # a slab that cannot break records no slab-crack series
+    plain = pst.attach(mw.Simulation(mw.load_scenario("pst_demo", SOFT_THIN[:-4] + ["scene.length=0.8"]),
+                                     device="cpu"))
+    assert plain.slab_crack is None and "slab_crack" not in plain.units()
+
+
+def test_a_soft_thin_slab_breaks_over_the_cut(tmp_path):
+    out = tmp_path / "sf.h5"
+    res = mw.run("pst_demo", output=str(out), overrides=SOFT_THIN + ["output.fields=['x','damage']"])
+    o = res.scene_result["outcome"]
+    assert o["class"] == "SF" and o["field_line"] == "PST 50/80 (SF) down 12 cm"
+    # it breaks behind the blade, within one slab thickness or so of the saw's tip, while the saw still cuts or
+    # just after (the saw stops at 0.6 s)
+    assert 0.5 - 2.0 * 0.12 < o["slab_fracture_at"] < 0.5 and 0.5 < o["slab_fracture_time"] < 0.7
+    run = mw.read_run(str(out))
+    assert run.attrs["outcome"]["pst"] == pytest.approx(o, nan_ok=True)
+    d = run.frame(-1)["damage"]
+    slab = run.static["group"] == [g["name"] for g in run.attrs["groups"]].index("slab")
+    assert (d[slab] >= 0.95).sum() >= 20                     # a crack across the slab's 24 particle rows
