@@ -25,6 +25,10 @@ from .density_laws import (
 from .records import ProfileError, ProfileLayer, ProfileLibraryMissing, PSTRecord, SnowProfileData
 from .selection import select_weak_layer
 
+__all__ = ["read_profile", "select_weak_layer", "SnowProfileData", "ProfileLayer", "PSTRecord", "ProfileError",
+           "ProfileLibraryMissing", "geldsetzer_jamieson_density", "hardness_index", "density_class",
+           "bergfeld_modulus", "sigrist_tensile_strength", "write_example", "example_path", "example_bytes"]
+
 
 def __getattr__(name):
     # the example module is loaded on use, so that `python -m mpm_warp.scenes.profile.example` runs it fresh
@@ -32,7 +36,3 @@ def __getattr__(name):
         from . import example
         return getattr(example, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-__all__ = ["read_profile", "select_weak_layer", "SnowProfileData", "ProfileLayer", "PSTRecord", "ProfileError",
-           "ProfileLibraryMissing", "geldsetzer_jamieson_density", "hardness_index", "density_class",
-           "bergfeld_modulus", "sigrist_tensile_strength", "write_example", "example_path", "example_bytes"]
