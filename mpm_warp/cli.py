@@ -143,7 +143,21 @@ def _summary(res, out=None):
         + (f"; {res.inversions} inversions (det F_tr <= 0) and {res.floor_events} singular-value floor events"
            if res.inversions or res.floor_events else "")
         + (f"\noutput: {res.output}" if res.output else "") + "\n")
-    for k, v in res.scene_result.items():
+    sr = dict(res.scene_result)
+    oc, weac = sr.pop("outcome", None), sr.pop("weac", None)
+    if oc is not None:
+        where = (f", the slab broke {oc['slab_fracture_at']:.2f} m from the cut end" if oc["class"] == "SF" else
+                 f", the crack stopped {oc['arrest_at']:.2f} m from the cut end" if oc["class"] == "ARR" else "")
+        out.write(f"  field: {oc['field_line']}{where}" + (f" ({oc['note']})" if oc.get("note") else "") + "\n")
+    if weac is not None:
+        if weac.get("weac") is None:
+            out.write(f"  weac: {weac['note']}\n")
+        else:
+            a_c = weac["critical_cut"]
+            out.write(f"  weac {weac['weac']}: critical cut " + (f"{a_c:.3f} m" if a_c is not None else "none")
+                      + f" (G = G_c = w_f = {weac['G_c']:.3g} J/m^2); G = {weac['energy_release_rate']:.3g} J/m^2 "
+                      f"at the cut of {weac['cut']:.3g} m\n")
+    for k, v in sr.items():
         out.write(f"  {k}: {_short(v)}\n")
 
 

@@ -11,9 +11,10 @@ from mpm_warp.errors import InvalidArgument, ScenarioError
 from mpm_warp.loader import load_scenario, resolved_scenario, scenario_from_dict
 from mpm_warp.model import Model
 from mpm_warp.scenes import pst
+from mpm_warp.scenes.density_laws import bergfeld_modulus
 from mpm_warp.scenes.pst.params import upgrade_table
 from mpm_warp.scenes.snow import Slab
-from mpm_warp.scenes.snowpack import SnowLayer, bergfeld_modulus, equivalent_slab, stack_normal_stress
+from mpm_warp.scenes.snowpack import SnowLayer, equivalent_slab, stack_normal_stress
 
 G = 9.81
 #: three slab layers, soft on top (top to bottom: 10 cm each)

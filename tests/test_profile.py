@@ -6,6 +6,7 @@ import datetime
 
 import numpy as np
 import pytest
+from helpers_profile import write  # noqa: E402
 
 from mpm_warp.errors import InvalidArgument, OutputError
 from mpm_warp.scenes.profile import (
@@ -16,10 +17,6 @@ from mpm_warp.scenes.profile import (
     select_weak_layer,
     write_example,
 )
-
-pytest.importorskip("snowprofile", reason="the profile extra (pip install -e '.[test]' installs it)")
-
-from helpers_profile import write  # noqa: E402
 
 
 def test_the_example_reads_back_with_its_densities_site_and_pst():

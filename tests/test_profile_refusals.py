@@ -8,13 +8,10 @@ import threading
 
 import numpy as np
 import pytest
+from helpers_profile import write  # noqa: E402
 
 from mpm_warp.scenes.profile import ProfileError, ProfileLibraryMissing, example_path, read_profile
 from mpm_warp.scenes.profile.source import MAX_BYTES
-
-pytest.importorskip("snowprofile", reason="the profile extra (pip install -e '.[test]' installs it)")
-
-from helpers_profile import write  # noqa: E402
 
 OK = [(0.0, 0.3, "RG", None, "1F"), (0.3, 0.02, "SH", None, "F"), (0.32, 0.4, "RG", "FC", "P")]
 

@@ -214,11 +214,11 @@ def test_critical_cut_bisects_and_runs_the_first_two_trials_at_once(monkeypatch,
 
     real, meet = cc._trial, threading.Barrier(2, timeout=60)
 
-    def trial(sim, mon, cut, run_distance, free_run, check_interval):
+    def trial(sim, mon, cut, run_distance, free_run, check_interval, classify=False):
         if workers == 2 and cut in (0.05, 0.5 * (0.05 + 0.1)):
             meet.wait()                    # BrokenBarrierError unless both run concurrently
-        out = real(sim, mon, cut, run_distance, free_run, check_interval)
-        return {**out, "propagated": cut > 0.07}
+        out = real(sim, mon, cut, run_distance, free_run, check_interval, classify)
+        return {**out, "propagated": cut > 0.07, "class": "END" if cut > 0.07 else "ARR"}
 
     monkeypatch.setattr(cc, "_trial", trial)
     sc = load_scenario("pst_demo", TINY)
@@ -227,6 +227,8 @@ def test_critical_cut_bisects_and_runs_the_first_two_trials_at_once(monkeypatch,
     assert res.bracketed and (res.lo, res.hi, res.value) == pytest.approx((0.0625, 0.075, 0.06875), abs=1e-15)
     assert [t["cut"] for t in res.trials] == pytest.approx([0.1, 0.05, 0.075, 0.0625], abs=1e-15)
     assert [t["propagated"] for t in res.trials] == [True, False, True, False]
+    assert res.classes == {"below": "ARR", "above": "END"}             # the class on each side of the cut
+    assert res.weac["critical_cut"] > 0 and res.weac["cut"] == res.value  # weac's static answer beside it
     # each trial from the last snapshot before its cut, and run to its saw's stop plus the free run
     p = sc.scene
     assert all(t["t_end"] == pytest.approx(p.saw_start + t["cut"] / p.saw.speed + 0.005) for t in res.trials[1:])

@@ -40,6 +40,18 @@ def running_frame(run: RunData, params: PSTParams) -> int:
     return int(k[0]) if len(k) else run.n_frames - 1
 
 
+def _slab_layers(ax, params: PSTParams, groups: list, gid, shown, L: float) -> None:
+    """A layered slab: its layers in alternating greys, each labelled with its density and E at the right end."""
+    stack = params.slab_stack()
+    if len(stack) < 2:
+        return
+    for k, layer in enumerate(stack):
+        sel = gid == groups.index(f"slab_{k + 1}")
+        ax.scatter(shown[sel, 0], shown[sel, 1], s=0.3, c="0.62" if k % 2 else "0.8", lw=0, rasterized=True)
+        y = float(np.median(shown[sel, 1]))
+        ax.text(L + 0.06, y, f"{layer.density:.0f} kg/m3, E {layer.modulus / 1e6:.2g} MPa", fontsize=6, va="center")
+
+
 def _settled_frame(run: RunData, params: PSTParams) -> int:
     return min(int(np.searchsorted(run.times, params.saw_start - 1e-12)), run.n_frames - 1)
 
@@ -94,6 +106,13 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     # ---------------------------------------------------------------- the column, displacements exaggerated
     grey = ~wl
     ax.scatter(shown[grey, 0], shown[grey, 1], s=0.3, c="0.75", lw=0, rasterized=True)
+    _slab_layers(ax, params, groups, gid, shown, L)
+    cracked = None
+    if "damage" in fr:                                   # a slab that can break: its cracked particles
+        cracked = grey & (fr["damage"].astype(float) >= 0.95)
+        if cracked.any():
+            ax.scatter(shown[cracked, 0], shown[cracked, 1], s=3.0, c="crimson", lw=0, rasterized=True,
+                       label="slab cracked through (damage >= 0.95)")
     sc = ax.scatter(shown[wl, 0], shown[wl, 1], s=2.5, c=collapse, cmap=CMAP, vmin=0.0, vmax=c_max, lw=0,
                     rasterized=True)
     y_top = params.base_y + D
@@ -107,7 +126,7 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
                 label=label)
     ax.set(xlim=(-0.05, L + 0.05), ylim=(-0.03, y_top + 0.08), xlabel="x along the column [m]", ylabel="y [m]")
     ax.set_aspect(max(1.0, 0.3 * (L + 0.1) / (y_top + 0.11)), adjustable="box")   # a column ~0.3 as high as long
-    ax.legend(loc="upper right", fontsize=8, ncols=3)
+    ax.legend(loc="lower right", fontsize=7, ncols=2, framealpha=0.9)
     cb = fig.colorbar(sc, ax=[ax, az], shrink=0.8, pad=0.01)
     cb.set_label("weak-layer collapse since settling, 1 - J_P/J_P,ref [-]\n(white: the law under the slab at rest)")
     cb.ax.axhline(h_c / params.weak_layer_thickness, color="w", lw=2)
@@ -134,8 +153,15 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
         bb = a.get_window_extent()
         return (bb.height / (y1 - y0)) / (bb.width / (x1 - x0))
 
-    ax.set_title(f"{run.scenario.get('name', 'PST')}: t = {t:.3f} s; displacements since settling exaggerated "
-                 f"x{f:.0f}, vertical axis stretched x{stretch(ax, -0.05, L + 0.05, -0.03, y_top + 0.08):.1f}")
+    outcome = (run.attrs.get("outcome") or {}).get("pst") or {}
+    line = f"{outcome['field_line']}\n" if outcome.get("field_line") else ""
+    if outcome.get("class") == "SF" and np.isfinite(outcome.get("slab_fracture_at", np.nan)):
+        xs = float(to_x(outcome["slab_fracture_at"]))
+        ax.annotate(f"slab fracture {outcome['slab_fracture_at']:.2f} m", (xs, y_top), (xs, y_top + 0.045),
+                    color="crimson", fontsize=8, ha="center", arrowprops=dict(arrowstyle="->", color="crimson"))
+    ax.set_title(f"{line}{run.scenario.get('name', 'PST')} at t = {t:.3f} s; displacements since settling "
+                 f"exaggerated x{f:.0f}, vertical axis stretched "
+                 f"x{stretch(ax, -0.05, L + 0.05, -0.03, y_top + 0.08):.1f}")
     az.set_title(f"zoom on the weak layer at the damage front: true displacements, vertical axis stretched "
                  f"x{stretch(az, lo, hi, y0, y1):.0f}")
     os.makedirs(os.path.dirname(os.path.abspath(out_png)), exist_ok=True)

@@ -1,9 +1,9 @@
 """Layered snow: a slab or a substratum as a stack of elastic layers, top to bottom (docs/model.md §8).
 
 A :class:`SnowLayer` has a thickness, a density and E, nu; an omitted E (0) comes from the density
-through the power law of Bergfeld et al. (2023) that weac uses. A stack's load on the layer below it,
-its bending-equivalent homogeneous slab (for the closed-form references) and its layer boundaries are
-functions of the stack here.
+through the power law of Bergfeld et al. (2023) that weac uses (:mod:`.density_laws`). A stack's load on
+the layer below it, its bending-equivalent homogeneous slab (for the closed-form references) and its layer
+boundaries are functions of the stack here.
 """
 
 from __future__ import annotations
@@ -11,46 +11,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
 from ..checks import finite_number
 from ..errors import InvalidArgument
 from ..materials import CrackingSnow
+from .density_laws import RHO_ICE, bergfeld_modulus, fracture_toughness, sigrist_tensile_strength
 from .snow import Slab, slab_normal_stress
 
-__all__ = ["SnowLayer", "RHO_ICE", "bergfeld_modulus", "sigrist_tensile_strength", "fracture_toughness",
-           "stack_thickness", "stack_normal_stress", "equivalent_slab", "check_stack"]
-
-#: density of ice (kg/m^3) in the density laws (the value weac uses in its modulus law)
-RHO_ICE = 916.7
-
-
-def bergfeld_modulus(density: float) -> float:
-    """Young's modulus of snow from its density (Pa): ``6.5e3 MPa (rho / rho_ice)^4.4``.
-
-    Bergfeld et al. (2023), NHESS 23:293, fitted to PST displacement fields; the law weac uses
-    (250 kg/m^3 gives 21.4 MPa, 150 kg/m^3 2.26 MPa).
-    """
-    return 6.5e9 * (float(density) / RHO_ICE) ** 4.4
-
-
-def sigrist_tensile_strength(density):
-    """Tensile strength of snow from its density (Pa): ``240 kPa (rho / 917)^2.44`` (Sigrist 2006; the law weac
-    uses). Float or array."""
-    return 2.4e5 * (np.asarray(density, dtype=float) / 917.0) ** 2.44 if np.ndim(density) else \
-        2.4e5 * (float(density) / 917.0) ** 2.44
-
-
-def fracture_toughness(density: float) -> float:
-    """Mode-I fracture toughness of snow from its density (Pa m^1/2): ``750 (rho / 200)^2``.
-
-    Schweizer, Michot and Kirchner (2004, Ann. Glaciol. 38) measured ``K_Ic`` with notched cantilever beams at
-    100-300 kg/m^3: typically 500-1000 Pa m^1/2, growing with relative density with an exponent of about 2. This
-    law takes their exponent and the middle of their typical range at 200 kg/m^3 (docs/model.md §9); the fracture
-    energy of a layer is then ``K_Ic^2 (1 - nu^2) / E`` (plane strain).
-    """
-    return 750.0 * (float(density) / 200.0) ** 2
-
+__all__ = ["SnowLayer", "stack_thickness", "stack_normal_stress", "equivalent_slab", "check_stack"]
 
 @dataclass(frozen=True)
 class SnowLayer:

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..checks import check_choices, finite_number
 from ..errors import InvalidArgument, MPMError
+from .density_laws import sigrist_tensile_strength
 
 __all__ = ["StaticColumn", "CriticalCut", "WeacUnavailable", "NOT_INSTALLED", "weac_version", "weac_unavailable",
            "weac_setup", "sigrist_tensile_strength", "energy_release_rate", "critical_cut", "critical_cut_search",
@@ -148,11 +149,6 @@ def weac_setup(column: StaticColumn) -> tuple[str, float]:
     left = column.cut_from == "upslope"
     base = "pst" if column.column_ends == "slope_normal" else "vpst"
     return ("-" + base if left else base + "-"), -abs(float(column.slope_angle))
-
-
-def sigrist_tensile_strength(density) -> np.ndarray | float:
-    """Slab tensile strength (Pa) of snow of ``density`` (kg/m^3): ``240 kPa (rho/917)^2.44`` (Sigrist 2006)."""
-    return 240.0e3 * (np.asarray(density, dtype=float) / 917.0) ** 2.44
 
 
 def _plate_stiffness(column: StaticColumn) -> tuple[float, float, float, float]:

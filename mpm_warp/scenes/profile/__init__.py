@@ -5,7 +5,7 @@
   slope, aspect, site, date, snow depth and PST results). Needs the optional ``snowprofile``
   library (``pip install 'mpm-warp[profile]'``), imported only when a file is read.
 - :func:`select_weak_layer` (:mod:`.selection`): the slab above, the weak layer, the layers below.
-- :mod:`.density_laws`: density from hand hardness and grain form (Geldsetzer and Jamieson 2000),
+- :mod:`..density_laws`: density from hand hardness and grain form (Geldsetzer and Jamieson 2000),
   Young's modulus (Bergfeld et al. 2023) and tensile strength (Sigrist 2006) from density.
 - :mod:`.example`: the project's own CAAML example, :func:`example_path`.
 
@@ -14,14 +14,14 @@ The library choice, the density law's coefficients and grain classes, and what i
 
 from __future__ import annotations
 
-from .caaml import read_profile
-from .density_laws import (
+from ..density_laws import (
     bergfeld_modulus,
     density_class,
     geldsetzer_jamieson_density,
     hardness_index,
     sigrist_tensile_strength,
 )
+from .caaml import read_profile
 from .records import ProfileError, ProfileLayer, ProfileLibraryMissing, PSTRecord, SnowProfileData
 from .selection import select_weak_layer
 

@@ -3,7 +3,7 @@
 The file is parsed by the ``snowprofile`` library (UMR-CNRM, the optional extra ``profile``:
 ``pip install 'mpm-warp[profile]'``): CAAML 6 XML (6.0.3 to 6.0.5) and CAAML 5 XML. Then every
 layer is checked and gets its density: from the profile's density profile where a sample overlaps
-it, otherwise from its hand hardness and grain form (:mod:`.density_laws`). What is refused, and why
+it, otherwise from its hand hardness and grain form (:mod:`..density_laws`). What is refused, and why
 gaps are not filled, is in docs/profiles.md; every refusal is one :class:`ProfileError` line naming
 the file, the layer (index from the top and depth) and the value.
 """
@@ -17,7 +17,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from .density_laws import GJ_FITS, GRAIN_CLASS, HARDNESS_INDEX, geldsetzer_jamieson_density
+from ..density_laws import GJ_FITS, GRAIN_CLASS, HARDNESS_INDEX, geldsetzer_jamieson_density
 from .diagnose import diagnose_layers
 from .records import MEASURED, ProfileError, ProfileLayer, ProfileLibraryMissing, PSTRecord, SnowProfileData, metres
 from .source import caaml_version, read_capped

@@ -2,7 +2,7 @@
 
 snowprofile checks a whole table at once ("Unauthorized value for key hardness"); to refuse in one
 line that names the layer, the stratigraphy and density layers are looked at one by one here, in
-file order, with the codes of :mod:`.density_laws`.
+file order, with the codes of :mod:`..density_laws`.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 
-from .density_laws import GRAIN_CLASS, HARDNESS_INDEX
+from ..density_laws import GRAIN_CLASS, HARDNESS_INDEX
 from .records import ProfileError, metres
 
 __all__ = ["diagnose_layers"]

@@ -33,6 +33,7 @@ from ..fronts import bisect_threshold
 from .analysis import end_zone
 from .monitor import PSTMonitor, attach
 from .params import PSTParams
+from .static import weac_answer
 
 __all__ = ["CriticalCut", "critical_cut", "cut_run"]
 
@@ -50,7 +51,8 @@ class CriticalCut:
     trials : list of dict
         ``cut`` (m), ``propagated``, ``front`` (m: the damage front's reach when the trial ended),
         ``t_start``, ``t_end`` (s: simulated times the trial started from its snapshot and ended; the
-        base run starts at 0), ``steps`` (the trial's own), ``wall`` (s).
+        base run starts at 0), ``steps`` (the trial's own), ``wall`` (s); with ``classify``, ``class`` (END, SF,
+        ARR: :func:`~.outcome.classify`), ``slab_fracture_at``, ``arrest_at`` (m from the cut end, nan).
     runaway_cut : float
         The base run's one-run estimate (m; nan if its crack never ran away from the saw).
     base : dict
@@ -61,6 +63,12 @@ class CriticalCut:
         False when a cut of ``lo`` propagated or one of ``hi`` arrested: ``value`` is nan and ``note``
         says which (the trials are kept).
     note : str
+    classes : dict
+        The field class on each side of the critical cut: ``below`` (the trial of ``lo``: an arrest) and
+        ``above`` (the trial of ``hi``: END, or SF when the slab broke first); empty without ``classify``.
+    weac : dict
+        weac's static answer for the same column (:func:`~.static.weac_answer`: its critical cut, and its
+        energy release rate at ``value``), or the one line saying weac is not installed.
     """
 
     value: float
@@ -72,6 +80,8 @@ class CriticalCut:
     wall: float
     bracketed: bool = True
     note: str = ""
+    classes: dict = dataclasses.field(default_factory=dict)
+    weac: dict = dataclasses.field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """Plain dict (JSON)."""
@@ -92,7 +102,7 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
                  free_run: float = 0.2, snapshot_every: float | None = None, check_interval: float = 0.01,
                  base_run_distance: float | None = None, base_free_run: float | None = None,
                  device: str | None = None, n_threads: int | None = None, workers: int = 1,
-                 log=None) -> CriticalCut:
+                 log=None, classify: bool = True) -> CriticalCut:
     """Bisect the critical cut of the PST ``scenario`` within ``[lo, hi]`` (m) to ``tol`` (m).
 
     Parameters
@@ -130,6 +140,10 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         one run fills the device, the trials stay serial.
     log : callable, optional
         ``log(str)`` for a line per trial.
+    classify : bool
+        A trial that propagated runs on until its field class is known (END, SF or ARR), so that every trial
+        and both sides of the bracket have one (about a third more time per propagating trial on the ladder
+        PST); False stops it once it propagated.
     """
     p = scenario.scene
     if not isinstance(p, PSTParams):
@@ -155,11 +169,12 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         a = min(a + step, hi)
         _step_recording(sim, mon, t_saw + a / v, check_interval)
     base = _trial(sim, mon, hi, run_distance if base_run_distance is None else base_run_distance,
-                  free_run if base_free_run is None else base_free_run, check_interval)
+                  free_run if base_free_run is None else base_free_run, check_interval, classify)
     base_summary = mon.result()
     trials = [{**base, "t_start": 0.0, "steps": sim.stepper.clock()[2], "wall": _time.perf_counter() - wall0}]
     if log:
-        log(f"cut {hi:.4g} m (base): propagated={base['propagated']}, front {base['front']:.3f} m")
+        log(f"cut {hi:.4g} m (base): propagated={base['propagated']}, front {base['front']:.3f} m, "
+            f"class {base.get('class')}")
     cache = {hi: base["propagated"]}
     lock = threading.Lock()
 
@@ -171,14 +186,14 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
         tsim, tmon = _simulation(_with_cut(scenario, cut), device, threads)
         tsim.load_snapshot(*snaps[k][1])
         steps0, t_start = tsim.stepper.clock()[2], tsim.time
-        out = _trial(tsim, tmon, cut, run_distance, free_run, check_interval)
+        out = _trial(tsim, tmon, cut, run_distance, free_run, check_interval, classify)
         out.update(t_start=t_start, steps=tsim.stepper.clock()[2] - steps0, wall=_time.perf_counter() - t0)
         with lock:
             trials.append(out)
             cache[cut] = out["propagated"]
             if log:
-                log(f"cut {cut:.4g} m: propagated={out['propagated']}, front {out['front']:.3f} m "
-                    f"({out['wall']:.0f} s)")
+                log(f"cut {cut:.4g} m: propagated={out['propagated']}, front {out['front']:.3f} m, "
+                    f"class {out.get('class')} ({out['wall']:.0f} s)")
         return out["propagated"]
 
     runaway = float(base_summary.get("runaway_cut", math.nan))
@@ -190,12 +205,23 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
             list(pool.map(lambda c: propagates(c, half), (lo, 0.5 * (lo + hi))))
         trials[1:] = sorted(trials[1:], key=lambda t: t["cut"] != lo)   # lo's trial first, as in the serial search
     low = propagates(lo)
+    weac = weac_answer(p, mon.calibration)
     if low or not cache[hi]:   # the critical cut is not in the bracket: say which end, keep the trials
         why = f"a cut of {lo:g} m propagated" if low else f"a cut of {hi:g} m arrested"
         return CriticalCut(math.nan, lo, hi, trials, runaway, base_summary, _time.perf_counter() - wall0,
-                           bracketed=False, note=why)
+                           bracketed=False, note=why, classes=_sides(trials, lo, hi, classify), weac=weac)
     b = bisect_threshold(propagates, lo, hi, tol, check_ends=False)
-    return CriticalCut(b.value, b.lo, b.hi, trials, runaway, base_summary, _time.perf_counter() - wall0)
+    weac = weac_answer(p, mon.calibration, cut=b.value)
+    return CriticalCut(b.value, b.lo, b.hi, trials, runaway, base_summary, _time.perf_counter() - wall0,
+                       classes=_sides(trials, b.lo, b.hi, classify), weac=weac)
+
+
+def _sides(trials: list, lo: float, hi: float, classify: bool) -> dict:
+    """The field class of the trials at the bracket's two ends."""
+    if not classify:
+        return {}
+    by_cut = {t["cut"]: t.get("class") for t in trials}
+    return {"below": by_cut.get(float(lo)), "above": by_cut.get(float(hi))}
 
 
 def cut_run(scenario, cut: float, run_distance: float, free_run: float, check_interval: float = 0.01,
@@ -237,18 +263,28 @@ def _step_recording(sim: Simulation, mon: PSTMonitor, t_end: float, check_interv
 
 
 def _trial(sim: Simulation, mon: PSTMonitor, cut: float, run_distance: float, free_run: float,
-           check_interval: float) -> dict:
-    """Run a trial from where ``sim`` is until its crack propagated or arrested."""
+           check_interval: float, classify: bool = False) -> dict:
+    """Run a trial from where ``sim`` is until its crack propagated or arrested; with ``classify``, a crack that
+    propagated runs on until its field class is known (END, SF or ARR: :func:`~.outcome.classify`), for at most
+    the time a crack at 5 m/s needs to cross the column."""
     p = mon.params
     goal = min(cut + run_distance, p.length - end_zone(p))
     t_stop = p.saw_start + cut / p.saw.speed + free_run
+    t_cap = t_stop + p.length / 5.0
     t = sim.time
-    front = 0.0
-    while t < t_stop - 1e-12:
-        t = min(t + check_interval, t_stop)
+    front, propagated = 0.0, False
+    while t < (t_cap if propagated and classify else t_stop) - 1e-12:
+        t = min(t + check_interval, t_cap if propagated and classify else t_stop)
         sim.step_to(t)
         mon.frame_scalars(sim)          # a frame of the monitor's series (touchdown, collapse height)
         front = mon.damage_front(t)
-        if front >= goal:
+        propagated = propagated or front >= goal
+        if propagated and not classify:
             break
-    return {"cut": float(cut), "propagated": bool(front >= goal), "front": float(front), "t_end": float(sim.time)}
+        if propagated and mon.outcome()["class"] is not None:
+            break
+    out = {"cut": float(cut), "propagated": bool(propagated), "front": float(front), "t_end": float(sim.time)}
+    if classify:
+        oc = mon.outcome()
+        out.update({"class": oc["class"], "slab_fracture_at": oc["slab_fracture_at"], "arrest_at": oc["arrest_at"]})
+    return out

@@ -13,6 +13,7 @@ from .build import layer_names
 from .kernels import deflection_kernel
 from .outcome import SlabCrackDetector, classify
 from .params import PSTParams
+from .static import weac_answer
 
 __all__ = ["PSTMonitor", "attach"]
 
@@ -136,6 +137,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
                           self.deflection_arrival())
         out["outcome"] = classify(self.params, times, series.get("front", []), series.get("slab_crack"),
                                   out["runaway_cut"])
+        out["weac"] = weac_answer(self.params, self.calibration)
         return out
 
     def outcome(self) -> dict:

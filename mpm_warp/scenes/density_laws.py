@@ -1,5 +1,5 @@
-"""Snow properties from what a field profile records: density from hand hardness and grain form,
-Young's modulus and tensile strength from density.
+"""Snow properties from what a field profile records: density from hand hardness and grain form;
+Young's modulus, tensile strength and fracture toughness from density (docs/model.md §8-9).
 
 - :func:`geldsetzer_jamieson_density`: Geldsetzer and Jamieson (2000), "Estimating dry snow density
   from grain form and hand hardness", Proc. ISSW 2000, Big Sky, 121-127: linear fits of density
@@ -8,6 +8,7 @@ Young's modulus and tensile strength from density.
   in docs/profiles.md.
 - :func:`bergfeld_modulus`: Bergfeld et al. (2023), NHESS 23:293, the law weac uses.
 - :func:`sigrist_tensile_strength`: Sigrist (2006), ETH Zurich dissertation 16736.
+- :func:`fracture_toughness`: the exponent and typical values of Schweizer, Michot and Kirchner (2004).
 """
 
 from __future__ import annotations
@@ -16,10 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InvalidArgument
+from ..errors import InvalidArgument
 
 __all__ = ["HARDNESS_INDEX", "GRAIN_CLASS", "GJ_FITS", "GJFit", "hardness_index", "density_class",
-           "geldsetzer_jamieson_density", "bergfeld_modulus", "sigrist_tensile_strength", "RHO_ICE"]
+           "geldsetzer_jamieson_density", "bergfeld_modulus", "sigrist_tensile_strength", "fracture_toughness",
+           "RHO_ICE"]
 
 #: density of ice (kg/m^3) in Sigrist's law; Bergfeld et al. use 916.7
 RHO_ICE = 917.0
@@ -186,3 +188,26 @@ def sigrist_tensile_strength(density):
     rho = _densities(density, "density")
     s = 240.0e3 * (rho / RHO_ICE) ** 2.44
     return float(s) if s.ndim == 0 else s
+
+
+def fracture_toughness(density):
+    """Mode-I fracture toughness of snow (Pa m^1/2) from its density: ``750 (rho / 200)^2``.
+
+    Schweizer, Michot and Kirchner (2004, Ann. Glaciol. 38) measured ``K_Ic`` with notched cantilever beams at
+    100-300 kg/m^3: typically 500-1000 Pa m^1/2, growing with relative density with an exponent of about 2. This
+    law takes their exponent and the middle of their typical range at 200 kg/m^3 (docs/model.md §9); a layer's
+    fracture energy is then ``K_Ic^2 (1 - nu^2) / E`` (plane strain).
+
+    Parameters
+    ----------
+    density : float or array_like
+        Density (kg/m^3), in (0, 917].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        K_Ic (Pa m^1/2): 750 at 200 kg/m^3, 422 at 150, 1172 at 250.
+    """
+    rho = _densities(density, "density")
+    k = 750.0 * (rho / 200.0) ** 2
+    return float(k) if k.ndim == 0 else k
