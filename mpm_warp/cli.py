@@ -198,6 +198,20 @@ def cmd_run(a) -> int:
         return _stopped(res, a.out)
     if a.json:
         print(json.dumps({k: v for k, v in res.__dict__.items() if k != "monitors"}, default=str))
+    if a.plot and a.out:
+        from .post.plots import plot_run
+
+        for f in plot_run(a.out, None):
+            print(f)
+    elif a.plot:
+        print("mpm-warp: --plot needs --out (a run file to plot)", file=sys.stderr)
+    return 0
+
+
+def cmd_profile(a) -> int:
+    from .scenes.profile import read_profile
+
+    print(read_profile(a.file).summary())
     return 0
 
 
@@ -355,6 +369,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "memory is always a limit)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--json", action="store_true", help="print the run summary as JSON")
+    r.add_argument("--plot", action="store_true", help="then plot the run (as `mpm-warp plot`; needs --out)")
     r.set_defaults(func=cmd_run)
 
     rs = sub.add_parser("resume", help="continue a run from its last checkpoint")
@@ -374,6 +389,9 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("run", help="HDF5 run file")
     pl.add_argument("--out", default=None, help="output folder (default: RUN_plots beside the run)")
     pl.set_defaults(func=cmd_plot)
+    pr = sub.add_parser("profile", help="read a CAAML snow profile: its layers, densities and PST results")
+    pr.add_argument("file", help="a CAAML 5 or 6 XML snow profile")
+    pr.set_defaults(func=cmd_profile)
     _add_sweep(sub)
     return p
 

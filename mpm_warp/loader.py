@@ -178,6 +178,9 @@ def scenario_from_dict(raw: dict, source: str = "scenario") -> Scenario:
                 raise ScenarioError(f"{source}: time.{k} is set by the {st.kind} scene; use [scene.settle] / "
                                     "scene.slope_angle")
     time = from_table(TimeControl, raw["time"], "time", source)
+    if st.expand is not None:
+        base = os.path.dirname(os.path.abspath(source)) if os.path.isfile(source) else os.getcwd()
+        table = st.expand(table, base)
     params = scene_params_from_dict(table, source)
     sc = st.build(params, time, common["output"], name=common["name"], precision=common["precision"],
                   description=str(raw.get("description", "")))

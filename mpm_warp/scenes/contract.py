@@ -48,6 +48,9 @@ class SceneType:
     upgrade : callable or None
         ``upgrade(table) -> table``: a ``[scene]`` table of an older release (a stored run file) in today's
         keys, before it is read.
+    expand : callable or None
+        ``expand(table, base_dir) -> table``: a scenario file's ``[scene]`` table with what it refers to read in
+        (a PST's snow profile into layers), once, when the file is loaded; stored run files hold the result.
     """
 
     kind: str
@@ -57,3 +60,4 @@ class SceneType:
     attach: Callable
     time_keys: tuple[str, ...] = ()
     upgrade: Callable | None = None
+    expand: Callable | None = None

@@ -47,14 +47,17 @@ from ..snow import SETTLE_TIME_KEYS
 from .analysis import pst_summary
 from .build import build
 from .critical import CriticalCut, critical_cut, cut_run
+from .from_profile import ProfileSource, expand_profile
 from .monitor import PSTMonitor, attach
 from .params import ColumnEnds, CutFrom, Front, PSTParams, Saw, upgrade_table
 
-__all__ = ["SCENE", "PSTParams", "Saw", "Front", "CutFrom", "ColumnEnds", "build", "attach", "PSTMonitor",
+__all__ = ["SCENE", "PSTParams", "Saw", "Front", "CutFrom", "ColumnEnds", "ProfileSource", "expand_profile",
+           "build", "attach", "PSTMonitor",
            "pst_summary", "critical_cut", "cut_run", "CriticalCut", "heierli_speed", "heierli_touchdown",
            "critical_cut_length_formula"]
 
 SCENE = SceneType(
     kind="pst", params=PSTParams, build=build, attach=attach, time_keys=SETTLE_TIME_KEYS, upgrade=upgrade_table,
+    expand=expand_profile,
     description="Propagation Saw Test: a slab on a weak layer, sawn from one end after settling; crack front, "
                 "speed, touchdown and collapse")

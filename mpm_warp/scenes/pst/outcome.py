@@ -84,7 +84,7 @@ class SlabCrackDetector:
 
 def field_line(cls: str | None, cut: float, length: float, depth: float) -> str:
     """The observer's line, e.g. ``PST 32/100 (END) down 50 cm``: cut and column length and the weak layer's depth
-    (slope-normal, below the surface) in whole centimetres."""
+    below the surface (measured vertically, as a profile records it) in whole centimetres."""
     c = cls if cls is not None else "running"
     return f"PST {round(100 * cut):d}/{round(100 * length):d} ({c}) down {round(100 * depth):d} cm"
 
@@ -107,13 +107,14 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
     -------
     dict
         ``class`` ("END", "SF", "ARR", or None while the crack still runs when the series ends),
-        ``field_line`` (:func:`field_line`), ``cut``, ``column_length``, ``depth`` (m), ``end_time``,
+        ``field_line`` (:func:`field_line`), ``cut``, ``column_length``, ``depth`` (m, vertical: the slab's
+        bed-normal thickness over the cosine of the slope), ``end_time``,
         ``slab_fracture_time`` (s, nan: never), ``slab_fracture_at`` (m from the cut end, nan), ``arrest_at``
         (m from the cut end for ARR, nan otherwise), ``note``.
     """
     t = np.asarray(times, dtype=float)
     fr = np.asarray(front, dtype=float)
-    L, D = float(params.length), float(params.slab_depth)
+    L, D = float(params.length), float(params.slab_depth) / math.cos(math.radians(params.slope_angle))
     cut = float(params.saw.cut_length) if saw_cut is None or not math.isfinite(saw_cut) else float(saw_cut)
     reach_end = np.nonzero(fr >= L - end_zone(params))[0]
     t_end = float(t[reach_end[0]]) if len(reach_end) else math.nan

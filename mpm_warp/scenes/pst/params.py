@@ -23,6 +23,7 @@ from ..snow import (
 )
 from ..snowpack import SnowLayer, check_stack, equivalent_slab, stack_normal_stress, stack_thickness
 from ..weak_layer import CalibratedWeakLayer, WeakLayer
+from .from_profile import ProfileSource
 
 __all__ = ["Saw", "Front", "PSTParams", "ColumnEnds", "CutFrom", "upgrade_table"]
 
@@ -124,6 +125,9 @@ class PSTParams:
         The slab can break: each slab layer cracks in tension (:class:`~mpm_warp.materials.CrackingSnow`) at its
         tensile strength and fracture energy (given, or from its density), over a crack band of one particle
         spacing, ``dx / particles_per_cell``. False (the default): an elastic slab, at no extra cost.
+    profile : ProfileSource
+        The CAAML snow profile the layers come from (:mod:`.from_profile`; the loader reads it once and fills the
+        layers); empty for a snowpack given in the file.
     slab_layers, substratum_layers : tuple of SnowLayer
         A layered slab or substratum, top to bottom (:class:`~mpm_warp.scenes.snowpack.SnowLayer`; an
         omitted E comes from the density). Given, they replace ``slab``/``slab_thickness`` (or
@@ -154,6 +158,7 @@ class PSTParams:
     slab_layers: tuple[SnowLayer, ...] = ()
     substratum_layers: tuple[SnowLayer, ...] = ()
     slab_fracture: bool = False
+    profile: ProfileSource = field(default_factory=ProfileSource)
 
     def validate(self, where: str = "scene") -> PSTParams:
         """Check every value (InvalidArgument naming ``where.field``, the value and the range); return self."""
@@ -168,6 +173,7 @@ class PSTParams:
         for part in ("slab", "substratum"):
             self._check_layers(part, where)
         finite_number(f"{where}.substratum_thickness (of the layers)", self.substratum_depth, lo=2.0 * dx)
+        self.profile.validate(f"{where}.profile")
         if not isinstance(self.slab_fracture, bool):
             raise InvalidArgument(f"{where}.slab_fracture", self.slab_fracture, "true or false")
         if self.slab_fracture:

@@ -1,0 +1,93 @@
+"""A PST from a CAAML snow profile (scenes/pst/from_profile.py, the ready scene pst_profile)."""
+
+import math
+import os
+
+import pytest
+
+import mpm_warp as mw
+from mpm_warp.cli import main
+from mpm_warp.errors import InvalidArgument, MPMError
+from mpm_warp.loader import resolved_scenario, scenario_from_dict
+from mpm_warp.scenes import pst
+from mpm_warp.scenes.density_laws import bergfeld_modulus
+from mpm_warp.scenes.profile import example_path
+
+COS35 = math.cos(math.radians(35.0))
+
+
+def test_the_example_profile_gives_the_pst_its_snowpack():
+    sc = mw.load_scenario("pst_profile")
+    p = sc.scene
+    # the profile's slope, its PST record's column, its layers above the surface hoar 48-50 cm down (vertical)
+    assert p.slope_angle == 35.0 and p.length == 1.0
+    top, wind = p.slab_stack()
+    assert (top.density, wind.density) == pytest.approx((81.0, 230.0))
+    assert top.thickness == pytest.approx(0.10 * COS35) and wind.thickness == pytest.approx(0.38 * COS35)
+    assert top.modulus == bergfeld_modulus(81.0) and "PP F" in top.name and "measured" in wind.name
+    assert p.weak_layer_thickness == pytest.approx(0.02 * COS35)
+    assert p.weak_layer.density == 150.0                 # buried surface hoar: not measured, from the file
+    (sub,) = p.substratum_stack()
+    assert sub.thickness == pytest.approx(0.15) and sub.density == pytest.approx(300.0)
+    assert len(p.profile.sha256) == 64 and p.profile.weak_layer.startswith("layer 2 (depth 0.48-0.5 m): SH")
+    # the layers load the weak layer: sum rho g h cos(slope)
+    assert p.sigma_n == pytest.approx(9.81 * COS35 * COS35 * (81.0 * 0.10 + 230.0 * 0.38), rel=1e-9)
+    assert [b.name for b in sc.blocks] == ["substratum", "weak_layer", "slab_2", "slab_1"]
+
+
+def test_a_stored_run_does_not_read_the_profile_again(monkeypatch):
+    sc = mw.load_scenario("pst_profile")
+    stored = sc.to_dict()
+
+    def gone(*a, **k):
+        raise AssertionError("the profile was read again")
+    monkeypatch.setattr(mw.scenes.profile, "read_profile", gone)
+    assert resolved_scenario(stored) == sc
+
+
+def _raw(**profile):
+    return {"name": "p", "time": {"end": 0.2, "frame_interval": 0.1},
+            "scene": {"kind": "pst", "dx": 0.005, "profile": {"file": str(example_path()), **profile}}}
+
+
+@pytest.mark.parametrize("profile, extra, needle", [
+    ({"weak_layer_depth": 1.5}, {}, "weak layer depth = 1.5 is invalid: expected a depth in [0.1, 1.2) m"),
+    ({"weak_layer_index": 9}, {}, "weak layer index = 9 is invalid: expected an integer in [1, 5]"),
+    ({"weak_layer_index": 1}, {}, "layer 2 (depth 0.48-0.5 m) density"),    # the SH layer in the slab
+    ({"weak_layer_depth": 0.49}, {"slab_thickness": 0.4}, "scene.slab_thickness = 0.4 is invalid: expected left out"),
+    ({"weak_layer_depth": 0.49, "thickness": "sideways"}, {}, "scene.profile.thickness"),
+    ({"weak_layer_depth": 0.49, "layers": 3}, {}, "scene.profile.layers = 3 is invalid"),
+])
+def test_bad_profile_choices_are_refused_in_one_line(profile, extra, needle):
+    raw = _raw(**profile)
+    raw["scene"].update(extra)
+    with pytest.raises(InvalidArgument) as e:
+        scenario_from_dict(raw)
+    assert needle in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_missing_profile_is_refused_naming_it(tmp_path):
+    raw = _raw(weak_layer_depth=0.49)
+    raw["scene"]["profile"]["file"] = str(tmp_path / "no_such_pit.caaml")
+    with pytest.raises(MPMError, match="no_such_pit.caaml"):
+        scenario_from_dict(raw)
+
+
+def test_the_profile_runs_to_a_picture_and_a_summary_in_one_command(tmp_path, capsys):
+    out = tmp_path / "pit.h5"
+    argv = ["run", "pst_profile", "--out", str(out), "--plot", "--quiet", "--set", "scene.length=0.4",
+            "--set", "time.end=0.06", "--set", "time.frame_interval=0.02"]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "field: PST 40/40" in text and "down 48 cm" in text        # the cut, the column, the depth as measured
+    assert "weac 2.6" in text and "critical cut" in text
+    pictures = [line for line in text.splitlines() if line.endswith(".png")]
+    assert pictures and all(os.path.getsize(f) > 10_000 for f in pictures)
+    assert main(["profile", str(example_path())]) == 0
+    assert "PST 32/100 (End) down 48 cm" in capsys.readouterr().out
+
+
+def test_from_python_a_profile_is_a_scene_table():
+    table = pst.expand_profile({"kind": "pst", "profile": {"file": str(example_path()), "weak_layer_index": 2}})
+    assert len(table["slab_layers"]) == 2 and table["slope_angle"] == 35.0
+    assert pst.expand_profile({"kind": "pst"}) == {"kind": "pst"}         # no profile: unchanged
