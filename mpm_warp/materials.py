@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from .camclay_forms import hardening_collapse
 from .checks import finite_number
 from .errors import InvalidArgument
 from .kernels.camclay import initial_log_jp
@@ -29,21 +30,6 @@ def lame_parameters(E, nu):
     mu = E / (2.0 * (1.0 + nu))
     lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     return mu, lam, lam + 2.0 * mu / 3.0
-
-
-def hardening_collapse(p, K: float, xi: float, p0_ini: float = 0.0):
-    """Plastic collapse ``1 - J_P / J_P,ini`` of Cam-Clay snow consolidated on the cap from ``p0_ini`` to ``p`` (-).
-
-    ``1 - exp(log_Jp(p) - log_Jp(p0_ini))`` with the hardening state of a consolidation
-    pressure, ``log_Jp(p0) = -asinh(p0 / K) / xi`` (:func:`mpm_warp.kernels.camclay.initial_log_jp`,
-    docs/model.md §3 and 6), i.e. ``1 - exp(-(asinh(p/K) - asinh(p0_ini/K)) / xi)``; zero where
-    ``p <= p0_ini`` (the cap does not move below its consolidation pressure). ``p``, ``p0_ini``
-    and ``K`` in Pa; ``p`` a float or an array.
-    """
-    log_jp = np.vectorize(initial_log_jp, otypes=[float])
-    c = 1.0 - np.exp(log_jp(p, K, xi) - initial_log_jp(p0_ini, K, xi))
-    c = np.where(np.asarray(p, dtype=float) > p0_ini, c, 0.0)
-    return float(c) if c.ndim == 0 else c
 
 
 @dataclass(frozen=True)

@@ -87,13 +87,10 @@ import pytest
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 import mpm_warp as mw
-from mpm_warp.materials import hardening_collapse
+from mpm_warp.camclay_forms import consolidation_pressure, hardening_collapse, oedometric_point, oedometric_ratio
 from mpm_warp.validation import (
-    consolidation_pressure,
     measure_column,
     oedometric_collapse,
-    oedometric_point,
-    oedometric_ratio,
     oedometric_state,
     run_column,
     weak_layer_column,

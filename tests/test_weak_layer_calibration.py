@@ -34,20 +34,20 @@ import numpy as np
 import pytest
 import warp as wp
 
+from mpm_warp.camclay_forms import consolidation_pressure, hardening_collapse
 from mpm_warp.errors import InvalidArgument, ScenarioError
 from mpm_warp.loader import material_from_table
 from mpm_warp.materials import BondedCamClay
 from mpm_warp.scenes.references import critical_cut_length_formula, weac_collapse_height
-from mpm_warp.scenes.weak_layer.calibration import heierli_anticrack, shear_range, weak_layer_material
+from mpm_warp.scenes.weak_layer.calibration import heierli_anticrack, weak_layer_material
+from mpm_warp.scenes.weak_layer.fit import shear_range
 from mpm_warp.scenes.weak_layer.paths import (
-    collapse_law,
     compressive_strength,
     drive_layer,
     loaded_shear_test,
     shear_strength,
     simple_shear_path,
 )
-from mpm_warp.validation.weak_layer import consolidation_pressure
 
 wp.config.quiet = True
 LAYER = dict(E=1.0e6, nu=0.3, density=150.0, D_wl=0.02, M=1.2, beta=0.3, slab_density=250.0, slab_thickness=0.5,
@@ -143,7 +143,7 @@ def test_debonded_layer_collapses_by_the_law_and_the_calibrated_height(layer):
     r = drive_layer(mat, F, -SIGMA_N * np.minimum(np.arange(1, n + 1) / (n / 2), 1.0), kappa0=mat.kappa_s)
     c_end = 1 - math.exp(r["log_jp"][0, -1] - mat.initial_log_jp)
     p0_end = float(consolidation_pressure(r["p"][0, -1], r["q"][0, -1], mat.M, 0.0))
-    law = float(collapse_law(mat, p0_end))
+    law = float(hardening_collapse(p0_end, mat.bulk, mat.xi, mat.p0_int_ini))
     print(f"debonded oedometer: collapse {c_end:.5f}, law at p0 = {p0_end:.1f} Pa: {law:.5f}, "
           f"calibrated h_c/D_wl {layer.h_c / layer.D_wl:.5f}")
     assert abs(c_end - law) < 1e-2 and abs(c_end - layer.h_c / layer.D_wl) < 1e-2
@@ -157,15 +157,14 @@ def test_collapse_after_shear_and_after_isotropic_crushing_follows_the_law(layer
     assert r["bond"][-1] == 0.0
     p0 = float(consolidation_pressure(r["p"][-1], r["q"][-1], mat.M, 0.0))
     c_shear = r["collapse"][-1]
-    print(f"after shear: collapse {c_shear:.5f}, law {float(collapse_law(mat, p0)):.5f}")
-    assert abs(c_shear - float(collapse_law(mat, p0))) < 1e-2
+    assert abs(c_shear - float(hardening_collapse(p0, mat.bulk, mat.xi, mat.p0_int_ini))) < 1e-2
     assert c_shear > layer.h_c / layer.D_wl  # sheared: p0 above the oedometric one (docs/model.md §3b)
     # isotropic compression beyond the intact strength: the bond breaks by compaction, then the intrinsic law
     e_end = -np.linspace(0.0, 0.5, 1001)[1:]
     iso = drive_layer(mat, np.exp(e_end / 3.0)[:, None, None] * np.eye(3))
     assert iso["bond"][0, -1] == 0.0 and np.max(-np.diff(iso["bond"][0])) < 0.1
     c_iso = 1 - math.exp(iso["log_jp"][0, -1] - mat.initial_log_jp)
-    c_iso_law = float(collapse_law(mat, iso["p"][0, -1]))
+    c_iso_law = float(hardening_collapse(iso["p"][0, -1], mat.bulk, mat.xi, mat.p0_int_ini))
     print(f"after isotropic crushing: collapse {c_iso:.5f}, law {c_iso_law:.5f}")
     assert abs(c_iso - c_iso_law) < 1e-2
 

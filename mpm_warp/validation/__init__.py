@@ -37,11 +37,8 @@ from __future__ import annotations
 from .common import G, com_velocity, observed_order, zero_crossings
 from .elastic import axial_bar, bar_period, column_scenario, fixed_free_bar, self_weight_column
 from .weak_layer import (
-    consolidation_pressure,
     measure_column,
     oedometric_collapse,
-    oedometric_point,
-    oedometric_ratio,
     oedometric_state,
     run_column,
     weak_layer_collapse,
@@ -51,7 +48,7 @@ from .weak_layer import (
 __all__ = [
     "PROBLEMS", "G", "axial_bar", "self_weight_column", "weak_layer_collapse",
     "fixed_free_bar", "bar_period", "column_scenario", "weak_layer_column", "run_column", "measure_column",
-    "oedometric_ratio", "oedometric_point", "consolidation_pressure", "oedometric_collapse",
+    "oedometric_collapse",
     "oedometric_state", "com_velocity", "zero_crossings", "observed_order",
 ]
 

@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 
+from .. import camclay_forms as forms
 from ..config import Block, Domain, Output, Scenario, TimeControl
-from ..materials import CamClaySnow, Elastic, hardening_collapse
+from ..materials import CamClaySnow, Elastic
 from ..simulation import Simulation
 from ..stress import kirchhoff_stress, pressure_and_mises
 from ..walls import Wall
@@ -15,61 +16,10 @@ from .common import G, _cells, _record
 
 
 # ------------------------------------------------- weak layer: closed form
-def oedometric_ratio(M: float, beta: float) -> float:
-    """``lambda_oed = max tau_v / p0`` on the yield ellipse (uniaxial strain, xi -> 0); dimensionless.
-
-    The ellipse has centre ``p0 (1 - beta)/2``, semi-axes ``a = p0 (1 + beta)/2``
-    in p and ``M a / sqrt(1 + 2 beta)`` in q; the largest ``p + 2 q / 3`` on it is
-    ``p0 [(1 - beta) + (1 + beta) sqrt(1 + 4 M^2 / (9 (1 + 2 beta)))] / 2``.
-    """
-    return 0.5 * ((1.0 - beta) + (1.0 + beta) * math.sqrt(1.0 + 4.0 * M * M / (9.0 * (1.0 + 2.0 * beta))))
-
-
-def oedometric_point(M: float, beta: float) -> tuple[float, float]:
-    """``(p / p0, q / p0)`` of the uniaxial-strain state on the ellipse (xi -> 0)."""
-    a = 0.5 * (1.0 + beta)
-    b = M * a / math.sqrt(1.0 + 2.0 * beta)
-    s = math.sqrt(a * a + (2.0 / 3.0) ** 2 * b * b)
-    return 0.5 * (1.0 - beta) + a * a / s, (2.0 / 3.0) * b * b / s
-
-
-def consolidation_pressure(p, q, M: float, beta: float):
-    """``p0`` (Pa) of the yield ellipse through the Kirchhoff state ``(p, q)`` (Pa).
-
-    The positive root of ``beta M^2 p0^2 + (1 - beta) M^2 p p0 - M^2 p^2 - (1 + 2 beta) q^2 = 0``;
-    equals ``p`` when ``q = 0``.
-    """
-    p = np.asarray(p, dtype=np.float64)
-    q = np.asarray(q, dtype=np.float64)
-    b = (1.0 - beta) * p
-    c = p * p + (1.0 + 2.0 * beta) * q * q / (M * M)
-    if beta == 0.0:
-        return c / b
-    return (-b + np.sqrt(b * b + 4.0 * beta * c)) / (2.0 * beta)
-
-
 def oedometric_collapse(W, mat: CamClaySnow) -> np.ndarray:
-    """Closed-form collapse ``1 - J_P`` of a laterally confined layer under the Cauchy load ``W`` (Pa).
-
-    Solves ``c = hardening_collapse(p0)`` with ``p0 = J_E (1 - c) W / lambda_oed``,
-    ``J_E = exp(-p/K)``, ``p = p0 (p/p0)_oed`` by bisection (derivation in
-    ``tests/test_weak_layer.py``); ``W`` may be an array. Zero where the load
-    stays inside the initial ellipse (``p0 <= p0_ini``).
-    """
-    W = np.atleast_1d(np.asarray(W, dtype=np.float64))
-    K, xi = mat.bulk, mat.xi
-    lam_oed = oedometric_ratio(mat.M, mat.beta)
-    p_over_p0 = oedometric_point(mat.M, mat.beta)[0]
-    lo = np.zeros_like(W)
-    hi = np.ones_like(W)
-    for _ in range(60):
-        c = 0.5 * (lo + hi)
-        p0 = W * (1.0 - c) / lam_oed
-        p0 = p0 * np.exp(-p0 * p_over_p0 / K)
-        g = c - hardening_collapse(p0, K, xi, mat.p0_ini)
-        hi = np.where(g > 0, c, hi)
-        lo = np.where(g > 0, lo, c)
-    return 0.5 * (lo + hi)
+    """Closed-form collapse ``1 - J_P`` of a laterally confined layer of ``mat`` under the Cauchy load ``W`` (Pa):
+    :func:`mpm_warp.camclay_forms.oedometric_collapse` (derivation in ``tests/test_weak_layer.py``); an array."""
+    return np.atleast_1d(forms.oedometric_collapse(W, mat.M, mat.beta, mat.bulk, mat.xi, mat.p0_ini))
 
 
 def oedometric_state(mat: CamClaySnow, axial_strain: float, n: int = 20000, dtype: str = "float64") -> dict:
@@ -114,7 +64,7 @@ def weak_layer_column(*, dx: float, xi: float, rho_slab: float, p0_ini: float = 
     slab = Elastic(E_slab, nu, rho_slab)
     H = D_wl + h_slab
     W_slab = rho_slab * G * h_slab
-    lam_oed = oedometric_ratio(M, beta)
+    lam_oed = forms.oedometric_ratio(M, beta)
     K = wl.bulk
     m = rho_slab * h_slab + rho_wl * D_wl / 3.0
     k_start = lam_oed * (xi * math.hypot(K, p0_ini) + p0_ini) / D_wl
@@ -166,7 +116,7 @@ def measure_column(sim: Simulation, wl: CamClaySnow, info: dict) -> dict:
     W = info["W_slab"] + info["rho_wl"] * G * (info["D_wl"] - y0)
     K = wl.bulk
     p0_hard = K * np.sinh(wl.xi * np.maximum(-ljp, 0.0))
-    p0_ell = consolidation_pressure(p, q, wl.M, wl.beta)
+    p0_ell = forms.consolidation_pressure(p, q, wl.M, wl.beta)
     collapse = 1.0 - np.exp(dl)
     # geometric thickness: interface between the top weak-layer and bottom slab particle layers
     x = sim.state.x.numpy().astype(np.float64)
@@ -179,7 +129,7 @@ def measure_column(sim: Simulation, wl: CamClaySnow, info: dict) -> dict:
         "collapse_theory": float(theory.mean()),
         "collapse_interior": float(collapse[inner].mean()) if inner.any() else float("nan"),
         "collapse_theory_interior": float(theory[inner].mean()) if inner.any() else float("nan"),
-        "collapse_theory_own_state": float(hardening_collapse(p0_ell, K, wl.xi, wl.p0_ini).mean()),
+        "collapse_theory_own_state": float(forms.hardening_collapse(p0_ell, K, wl.xi, wl.p0_ini).mean()),
         "h_c": float(collapse.mean() * info["D_wl"]),
         "thickness_change": float(info["D_wl"] - D_now),
         "thickness_change_from_J": float(info["D_wl"] * (1.0 - J.mean())),

@@ -39,14 +39,16 @@ import math
 
 import numpy as np
 
+from ...camclay_forms import consolidation_pressure, oedometric_p0
+from ...camclay_forms import oedometric_collapse as confined_collapse
 from ...errors import InvalidArgument
 from ...material_point import drive_material_points
 from ...materials import BondedCamClay
-from ...validation.weak_layer import consolidation_pressure, oedometric_point, oedometric_ratio
+from ...stress import cauchy_stress
 
 __all__ = [
     "compressive_strength", "elastic_shear_state", "shear_strength", "bond_pressure_for_shear_strength",
-    "collapse_law", "oedometric_collapse", "xi_for_collapse", "loaded_shear_test",
+    "oedometric_collapse", "xi_for_collapse", "loaded_shear_test",
 ]
 
 
@@ -76,11 +78,7 @@ def drive_layer(mat: BondedCamClay, F_total, sigma_yy=None, *, kappa0=None, dtyp
 
 def _hencky_cauchy(mat, lam_y: float, gamma: float) -> np.ndarray:
     """Cauchy stress (Pa, 3x3) of the elastic state ``F = [[1, gamma, 0], [0, lam_y, 0], [0, 0, 1]]``."""
-    F = np.array([[1.0, gamma, 0.0], [0.0, lam_y, 0.0], [0.0, 0.0, 1.0]])
-    w, V = np.linalg.eigh(F @ F.T)
-    eps = (V * (0.5 * np.log(w))) @ V.T
-    tau = 2.0 * mat.mu * eps + mat.lam * np.trace(eps) * np.eye(3)
-    return tau / lam_y
+    return cauchy_stress(np.array([[1.0, gamma, 0.0], [0.0, lam_y, 0.0], [0.0, 0.0, 1.0]]), mat.mu, mat.lam)[0]
 
 
 def _p_q(sigma: np.ndarray, J: float) -> tuple[float, float]:
@@ -171,39 +169,14 @@ def bond_pressure_for_shear_strength(tau_p: float, sigma_n: float, E: float, nu:
     return float(consolidation_pressure(p, q, M, beta)) - p0_int
 
 
-def collapse_law(mat: BondedCamClay, p0_int) -> np.ndarray:
-    """Intrinsic hardening law: collapse ``1 - J_P/J_P(0) = 1 - exp(-(asinh(p0/K) - asinh(p0_int_ini/K))/xi)``.
-
-    ``p0_int`` (Pa) is the intrinsic consolidation pressure of the final state
-    (docs/model.md §3, 6; the debonded layer: ``p0 = p0_int``).
-    """
-    K = mat.bulk
-    return 1.0 - np.exp(-(np.arcsinh(np.asarray(p0_int, dtype=np.float64) / K) - math.asinh(mat.p0_int_ini / K))
-                        / mat.xi)
-
-
-def _oedometric_p0(collapse: float, sigma_n: float, M: float, K: float) -> float:
-    """``p0`` of the debonded layer (``beta_e = 0``) on its oedometric point under the Cauchy load ``sigma_n``.
-
-    Kirchhoff ``tau_v = J sigma_n``, ``J = J_E (1 - collapse)``, ``J_E = exp(-p/K)``;
-    ``tau_v = lambda_oed p0`` (xi -> 0 limit, :func:`oedometric_ratio`); fixed point in ``J_E``.
-    """
-    lam_oed = oedometric_ratio(M, 0.0)
-    p_over = oedometric_point(M, 0.0)[0]
-    p0 = (1.0 - collapse) * sigma_n / lam_oed
-    for _ in range(50):
-        p0 = math.exp(-p0 * p_over / K) * (1.0 - collapse) * sigma_n / lam_oed
-    return p0
-
-
 def xi_for_collapse(collapse: float, sigma_n: float, M: float, K: float, p0_int_ini: float) -> float:
     """Hardening factor ``xi`` that makes the debonded layer collapse by ``collapse`` under ``sigma_n``.
 
     ``xi = (asinh(p0_f/K) - asinh(p0_int_ini/K)) / (-ln(1 - collapse))`` with ``p0_f``
-    the final oedometric consolidation pressure (:func:`_oedometric_p0`); Pa for
+    the final oedometric consolidation pressure (:func:`mpm_warp.camclay_forms.oedometric_p0`); Pa for
     stresses, ``collapse`` in (0, 1).
     """
-    p0_f = _oedometric_p0(collapse, sigma_n, M, K)
+    p0_f = float(oedometric_p0(collapse, sigma_n, M, 0.0, K))
     if p0_f <= p0_int_ini:
         raise InvalidArgument("p0_int_ini", p0_int_ini, f"a number below the final consolidation pressure "
                                                         f"{p0_f:.4g} Pa (else the debonded layer does not collapse)")
@@ -211,19 +184,9 @@ def xi_for_collapse(collapse: float, sigma_n: float, M: float, K: float, p0_int_
 
 
 def oedometric_collapse(mat: BondedCamClay, sigma_n: float) -> float:
-    """Collapse ``1 - J_P/J_P(0)`` of the debonded layer at rest under ``sigma_n`` (Pa), uniaxial strain.
-
-    The fixed point of ``c = collapse_law(p0_f(c))`` (:func:`_oedometric_p0`), by
-    bisection; the inverse of :func:`xi_for_collapse`.
-    """
-    lo, hi = 0.0, 1.0
-    for _ in range(100):
-        c = 0.5 * (lo + hi)
-        if c > max(float(collapse_law(mat, _oedometric_p0(c, sigma_n, mat.M, mat.bulk))), 0.0):
-            hi = c
-        else:
-            lo = c
-    return 0.5 * (lo + hi)
+    """Collapse ``1 - J_P/J_P(0)`` of the debonded layer (cohesion 0) at rest under ``sigma_n`` (Pa), uniaxial
+    strain: :func:`mpm_warp.camclay_forms.oedometric_collapse`; the inverse of :func:`xi_for_collapse`."""
+    return float(confined_collapse(sigma_n, mat.M, 0.0, mat.bulk, mat.xi, mat.p0_int_ini))
 
 
 def loaded_shear_test(mat: BondedCamClay, sigma_n: float, D_wl: float, gamma_end: float, n_increments: int,
