@@ -37,7 +37,7 @@ def _probe(T):
     @wp.kernel(enable_backward=False)
     def probe(sig: wp.array(dtype=v3), ljp: wp.array(dtype=T), par: wp.array2d(dtype=T),
               sig_out: wp.array(dtype=v3), ljp_out: wp.array(dtype=T), flag: wp.array(dtype=wp.int32),
-              res: wp.array2d(dtype=T), tau: wp.array(dtype=v3)):
+              res: wp.array2d(dtype=T), tau: wp.array(dtype=v3), eps_out: wp.array(dtype=v3)):
         i = wp.tid()
         mu, lam, M, beta, xi, pf = par[i, 0], par[i, 1], par[i, 2], par[i, 3], par[i, 4], par[i, 5]
         s = sig[i]
@@ -48,6 +48,7 @@ def _probe(T):
         if y != 0:
             s2 = v3(wp.exp(e2[0]), wp.exp(e2[1]), wp.exp(e2[2]))
         sig_out[i] = s2
+        eps_out[i] = e2
         ljp_out[i] = l2
         flag[i] = y
         p0 = p0f(ljp[i], lam + T(2.0) / T(3.0) * mu, xi, pf)
@@ -63,7 +64,8 @@ def _probe(T):
 
 def run_return(sig, ljp, cases, dtype):
     """Run the probe kernel; returns dict of numpy arrays (float64 except ``flag``; ``sig_raw`` in the
-    kernel's type). ``cases``: arrays ``mu``, ``lam`` (Pa), ``M``, ``beta``, ``xi`` (-), ``p0_floor`` (Pa)."""
+    kernel's type; ``eps`` the new principal strains as the return gave them). ``cases``: arrays ``mu``,
+    ``lam`` (Pa), ``M``, ``beta``, ``xi`` (-), ``p0_floor`` (Pa)."""
     T, nt, _ = TYPES[dtype]
     n = len(sig)
     v3 = vec3(T)
@@ -72,12 +74,13 @@ def run_return(sig, ljp, cases, dtype):
             device=DEVICE), wp.array(par.astype(nt), dtype=T, device=DEVICE)]
     outs = [wp.zeros(n, dtype=v3, device=DEVICE), wp.zeros(n, dtype=T, device=DEVICE),
             wp.zeros(n, dtype=wp.int32, device=DEVICE), wp.zeros((n, 4), dtype=T, device=DEVICE),
-            wp.zeros(n, dtype=v3, device=DEVICE)]
+            wp.zeros(n, dtype=v3, device=DEVICE), wp.zeros(n, dtype=v3, device=DEVICE)]
     wp.launch(_probe(T), dim=n, inputs=args, outputs=outs, device=DEVICE)
-    sig_out, ljp_out, flag, res, tau = (o.numpy() for o in outs)
+    sig_out, ljp_out, flag, res, tau, eps = (o.numpy() for o in outs)
     return {"sig_raw": sig_out, "sig": sig_out.astype(np.float64), "ljp": ljp_out.astype(np.float64),
             "flag": flag, "p": res[:, 0].astype(np.float64), "q": res[:, 1].astype(np.float64),
-            "p0": res[:, 2].astype(np.float64), "y": res[:, 3].astype(np.float64), "tau": tau.astype(np.float64)}
+            "p0": res[:, 2].astype(np.float64), "y": res[:, 3].astype(np.float64), "tau": tau.astype(np.float64),
+            "eps": eps.astype(np.float64)}
 
 
 def pq_np(sig, mu, lam):
