@@ -3,7 +3,7 @@
 The weak layer's yield ellipse carries a bonded part that decays with the plastic work done, so the layer
 is strong while its bonds hold and collapses once they break (docs/model.md §3b). Stresses are Kirchhoff
 (Pa), compression positive. The return is implicit in both state variables, two nested scalar root finds
-around camclay's closest-point projection (docs/model.md §4); the column mean of the work is in
+around camclay's closest-point projection (docs/model.md §3b, the projection §4); the column mean is in
 ``kernels/crack_band.py``.
 """
 
@@ -86,7 +86,7 @@ def _project_func(T):
 
     Returns ``(p, q, dp_dp0)``: the point (the trial itself when inside) and the
     derivative of its ``p`` with respect to ``p0`` at fixed ``beta_e`` (the
-    homothety derivative, docs/model.md §4; 0 inside). Same scaled
+    homothety derivative, docs/model.md §3b; 0 inside). Same scaled
     coordinates and tip handling as camclay's projection: ``u = (p - pc)/a``,
     ``v = q/(a rho)``, ellipse ``u^2 + v^2/c^2 = 1``, ``c = M/(rho sqrt(1 + 2 beta_e))``.
     """
@@ -117,7 +117,7 @@ def _project_func(T):
 
 @functools.cache
 def _volumetric_solve_func(T):
-    """Implicit volumetric hardening at a fixed bond ``b``: root ``L`` of ``g`` (docs/model.md §4).
+    """Implicit volumetric hardening at a fixed bond ``b``: root ``L`` of ``g`` (docs/model.md §3b).
 
     Returns ``(L, p, q)`` with ``(p, q)`` the closest point on the surface of
     ``(L, b)``. Newton from ``L_guess`` kept in the bracket (bisection when a step
