@@ -2,7 +2,8 @@
 
 Usage: ``python benchmarks/bonded_return_cost.py [--device cpu|cuda] [--n 1000000] [--precision float32]``.
 Writes ``benchmarks/results/bonded_return_cost_<device>.json``. One kernel launch
-returns ``n`` independent principal states (no SVD: the returns alone), with
+returns ``n`` independent principal Hencky strains (no decomposition: the returns alone,
+``bonded_camclay_return_strain`` and ``camclay_return_strain``), with
 the weak layer of the PST (E 1 MPa, nu 0.3, M 1.2, beta 0.3, xi 0.0041, p_bond
 3058 Pa, kappa_s 0.025: ``mpm_warp.scenes.weak_layer.calibration.weak_layer_material(tau_p=1000,
 w_f=0.3, ...)``) and camclay with the same intact ellipse (p0 = 3067 Pa).
@@ -25,8 +26,8 @@ import numpy as np  # noqa: E402
 import warp as wp  # noqa: E402
 from common import environment, write_json  # noqa: E402
 
-from mpm_warp.kernels.bonded_camclay import bonded_camclay_return_func  # noqa: E402
-from mpm_warp.kernels.camclay import camclay_return_func, initial_log_jp  # noqa: E402
+from mpm_warp.kernels.bonded_camclay import bonded_camclay_return_strain_func  # noqa: E402
+from mpm_warp.kernels.camclay import camclay_return_strain_func, initial_log_jp  # noqa: E402
 from mpm_warp.kernels.types import vec3  # noqa: E402
 
 E, NU, M, BETA, XI, P_BOND, KAPPA_S = 1e6, 0.3, 1.2, 0.3, 0.0041261, 3058.3, 0.025374
@@ -39,30 +40,30 @@ P0_INTACT = P0_FLOOR + P_BOND
 @functools.cache
 def _kernels(T):
     v3 = vec3(T)
-    bonded, camclay = bonded_camclay_return_func(T), camclay_return_func(T)
+    bonded, camclay = bonded_camclay_return_strain_func(T), camclay_return_strain_func(T)
 
     @wp.kernel(enable_backward=False)
-    def run_bonded(sig: wp.array(dtype=v3), kap: wp.array(dtype=T), sig_out: wp.array(dtype=v3),
+    def run_bonded(eps: wp.array(dtype=v3), kap: wp.array(dtype=T), eps_out: wp.array(dtype=v3),
                    ljp_out: wp.array(dtype=T), kap_out: wp.array(dtype=T)):
         i = wp.tid()
-        s, lj, k, y = bonded(sig[i], T(0.0), kap[i], T(MU), T(LAM), T(M), T(BETA), T(XI), T(P0_FLOOR), T(P_BOND),
+        s, lj, k, y = bonded(eps[i], T(0.0), kap[i], T(MU), T(LAM), T(M), T(BETA), T(XI), T(P0_FLOOR), T(P_BOND),
                              T(KAPPA_S))
-        sig_out[i] = s
+        eps_out[i] = s
         ljp_out[i] = lj
         kap_out[i] = k
 
     @wp.kernel(enable_backward=False)
-    def run_camclay(sig: wp.array(dtype=v3), ljp: T, sig_out: wp.array(dtype=v3), ljp_out: wp.array(dtype=T)):
+    def run_camclay(eps: wp.array(dtype=v3), ljp: T, eps_out: wp.array(dtype=v3), ljp_out: wp.array(dtype=T)):
         i = wp.tid()
-        s, lj, y = camclay(sig[i], ljp, T(MU), T(LAM), T(M), T(BETA), T(XI), T(P0_FLOOR))
-        sig_out[i] = s
+        s, lj, y = camclay(eps[i], ljp, T(MU), T(LAM), T(M), T(BETA), T(XI), T(P0_FLOOR))
+        eps_out[i] = s
         ljp_out[i] = lj
 
     return run_bonded, run_camclay
 
 
 def trial_sets(n: int, seed: int = 0) -> dict:
-    """Principal trial stretches (n, 3) and kappa (n,) for each set (module docstring)."""
+    """Principal trial Hencky strains (n, 3) and kappa (n,) for each set (module docstring)."""
     rng = np.random.default_rng(seed)
     # the settled state under the slab: uniaxial strain at sigma_n = 1226 Pa
     e_settled = np.array([0.0, -1226.0 / (LAM + 2 * MU), 0.0])
@@ -75,7 +76,7 @@ def trial_sets(n: int, seed: int = 0) -> dict:
         "yield_bond_gone": (on_surface + 1e-4 * direction, np.full(n, 2.0 * KAPPA_S)),
         "yield_far": (on_surface + 1e-2 * direction * rng.uniform(0, 1, (n, 1)), np.full(n, 0.3 * KAPPA_S)),
     }
-    return {k: (np.exp(-np.sort(-e, axis=1)), kap) for k, (e, kap) in sets.items()}
+    return {k: (-np.sort(-e, axis=1), kap) for k, (e, kap) in sets.items()}
 
 
 def _time(kernel, n, inputs, device) -> list[float]:
@@ -100,10 +101,10 @@ def main(argv=None) -> int:
     dev = wp.get_device(a.device)
     run_bonded, run_camclay = _kernels(T)
     rows = []
-    for name, (sig, kap) in trial_sets(a.n).items():
+    for name, (eps, kap) in trial_sets(a.n).items():
         # camclay with the same ellipse: the intact one, or p0 at its floor once the bond is gone
         ljp_cam = 0.0 if name == "yield_bond_gone" else initial_log_jp(P0_INTACT, K, XI)
-        s = wp.array(sig.astype(nt), dtype=vec3(T), device=dev)
+        s = wp.array(eps.astype(nt), dtype=vec3(T), device=dev)
         k = wp.array(kap.astype(nt), dtype=T, device=dev)
         so = wp.zeros_like(s)
         lo, ko = wp.zeros(a.n, dtype=T, device=dev), wp.zeros(a.n, dtype=T, device=dev)

@@ -1,25 +1,9 @@
-"""Modified Cam-Clay with cohesion: yield, hardening and return mapping.
+"""Modified Cam-Clay with cohesion: yield function, hardening and the closest-point return mapping.
 
-Implements docs/model.md §2-4 (Gaume et al. 2018, Supplementary Note 1).
-Stresses are Kirchhoff, in Pa, compression positive:
-
-    p = -K tr(eps),   q = sqrt(6) mu |dev eps|,   K = lam + 2 mu / 3
-    y(p, q) = (1 + 2 beta) q^2 + M^2 (p + beta p0)(p - p0)          (yield, <= 0)
-    p0 = K sinh(xi max(-log_Jp, 0))                                  (hardening)
-
-with ``eps = ln s`` the principal Hencky strains of the elastic deformation
-gradient. Every device function comes from a cached factory of the scalar type
-``T`` (``wp.float32`` or ``wp.float64``).
-
-Numerical constants (fixed, not model parameters)
---------------------------------------------------
-``SINGULAR_VALUE_FLOOR`` (1e-6): singular values are floored there before the
-logarithm, so an inverted or nearly singular ``F_E`` gives finite strains
-(``|eps_i| <= 13.8`` on the compressive side). The engine should pass the same
-value as ``s_floor`` to :func:`mpm_warp.kernels.elasticity.hencky_func`.
-``p0`` is capped at ``-3 K ln(SINGULAR_VALUE_FLOOR)`` (about 41.4 K), the
-pressure of the most compressed representable state, which keeps ``sinh``
-and ``exp`` finite for any ``log_Jp``.
+Implements docs/model.md §2-4 (Gaume et al. 2018, Supplementary Note 1). Stresses are Kirchhoff (Pa),
+compression positive; strains are principal Hencky strains. Every device function comes from a cached
+factory of the scalar type ``T`` (``wp.float32`` or ``wp.float64``). The projection onto the ellipse
+(:func:`ellipse_point_func`) is shared with the bonded weak layer (``kernels/bonded_camclay.py``).
 """
 
 import functools
@@ -35,14 +19,15 @@ __all__ = [
     "camclay_pq_func",
     "camclay_project_func",
     "ellipse_point_func",
-    "camclay_return_func",
     "camclay_return_strain_func",
     "camclay_yield_func",
     "initial_log_jp",
 ]
 
 SINGULAR_VALUE_FLOOR = 1.0e-6
-"""Floor on singular values before ``ln`` (dimensionless); fixed, not tunable."""
+"""Floor on singular values before ``ln`` (dimensionless; fixed, not tunable): an inverted or nearly singular
+``F_E`` gives finite strains, ``|eps_i| <= 13.8`` (docs/model.md §4). The engine passes the same value as
+``s_floor``; ``p0`` is capped at the pressure of the most compressed representable state, ``-3 K ln(floor)``."""
 
 _SQRT6 = math.sqrt(6.0)
 _P0_CAP_OVER_K = -3.0 * math.log(SINGULAR_VALUE_FLOOR)
@@ -147,20 +132,12 @@ def camclay_pq_func(T):
 
 @functools.cache
 def _ellipse_closest_func(T):
-    """Closest point of the ellipse ``(x0/e0)^2 + (x1/e1)^2 = 1`` to ``(y0, y1)``.
+    """Closest point of the ellipse ``(x0/e0)^2 + (x1/e1)^2 = 1`` to ``(y0, y1)`` (docs/model.md §4).
 
-    First quadrant only (``y0, y1 >= 0``), ``e0 >= e1 >= 0``, point outside or
-    on the ellipse (the inside is never asked for). Follows Eberly's
-    parametrisation ``x0 = r0 y0 / (s + r0)``, ``x1 = y1 / (s + 1)``,
-    ``r0 = (e0/e1)^2``, with ``s >= 0`` the root of the convex decreasing
-    ``F(s) = (r0 z0 / (s + r0))^2 + (z1 / (s + 1))^2 - 1``, ``z = y / e``.
-    The root is bracketed by ``[max(0, z1 - 1, r0 (z0 - 1)), |(r0 z0, z1)| - 1]``
-    and found by Newton steps from the left end (they never overshoot on a
-    convex decreasing function) interleaved with bisection, so each iteration
-    at least halves the bracket. Stops when ``0 <= F(s) <= 4 eps`` (``F`` is
-    the ellipse equation at the point, i.e. the yield function over
-    ``M^2 a^2``), when the bracket is below ``4 eps (1 + s)``, or after 100
-    iterations (typically 1-4, at most about 30 for aspect ratios of 1e4).
+    First quadrant only (``y0, y1 >= 0``), ``e0 >= e1 >= 0``, the point outside or on the ellipse:
+    ``x0 = r0 y0 / (s + r0)``, ``x1 = y1 / (s + 1)``, ``r0 = (e0/e1)^2``, with ``s >= 0`` the root of
+    ``F(s) = (r0 z0 / (s + r0))^2 + (z1 / (s + 1))^2 - 1``, ``z = y / e``, by safeguarded Newton steps and
+    bisection; stops when ``0 <= F <= 4 eps``, the bracket is below ``4 eps (1 + s)``, or after 100 iterations.
     """
     eps = 4.0 * (2.0**-23 if T == wp.float32 else 2.0**-52)
     max_it = _MAX_ROOT_ITERATIONS
@@ -217,85 +194,12 @@ def _ellipse_closest_func(T):
 
 
 @functools.cache
-def camclay_return_func(T):
-    """Build the Cam-Clay return mapping ``camclay_return`` for scalar type ``T``.
-
-    Signature of the returned ``wp.func``::
-
-        camclay_return(sig: vec3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T,
-                       p0_floor: T) -> (sig_new: vec3, log_jp_new: T, yielded: int32)
-
-    Parameters
-    ----------
-    sig : vec3
-        Singular values of the trial elastic deformation gradient ``F_E_tr``
-        (dimensionless, as from ``wp.svd3``: descending, the last possibly
-        negative or tiny; floored at ``SINGULAR_VALUE_FLOOR`` before ``ln``).
-    log_jp : T
-        Hardening state ``ln det F_P`` (dimensionless).
-    mu, lam : T
-        Lame parameters (Pa). M : slope of the critical state line; beta :
-        cohesion ratio (>= 0); xi : hardening coefficient (> 0), dimensionless.
-    p0_floor : T
-        Floor on ``p0`` (Pa; e.g. 1e-5 K, keep it above ~1e-20 K so that the
-        scaled trial state stays representable), see :func:`camclay_p0_func`.
-
-    Returns
-    -------
-    sig_new : vec3
-        Singular values of the new ``F_E`` (same ``U``, ``V``). For an elastic
-        trial (``y <= 0``) the input ``sig`` itself, bit for bit.
-    log_jp_new : T
-        ``log_jp + tr(eps_tr) - tr(eps_new)`` (hardening applied after the
-        projection, explicit in ``p0``; docs/model.md §4).
-    yielded : int32
-        1 if a projection happened, 0 otherwise.
-
-    Notes
-    -----
-    The discrete flow rule ``eps_tr - eps_new = dgamma dy/dtau`` (SI Eq. 4) with
-    Hencky elasticity maps ``(p, q)`` by ``-dgamma diag(K, 3 mu) grad y``: the
-    new state is the point of the ellipse closest to ``(p_tr, q_tr)`` in the
-    energy metric ``dp^2/K + dq^2/(3 mu)`` (SI Eq. 5, "ray-ellipse
-    intersection"). In the scaled coordinates ``u = (p - pc)/a``,
-    ``v = q sqrt(K/(3 mu))/a`` (``pc = p0 (1 - beta)/2``, ``a = p0 (1 + beta)/2``)
-    the ellipse has semi-axes ``1`` and ``c = M sqrt(K/(3 mu (1 + 2 beta)))``
-    and the Euclidean closest point is found in the first quadrant
-    (``q >= 0``, mirrored in ``p``). Then ``tr(eps_new) = -p_new/K`` and
-    ``dev(eps_new) = dev(eps_tr) q_new/q_tr`` (direction kept).
-
-    Edge cases: ``q_tr = 0`` (repeated singular values, direction undefined,
-    ``dev eps`` stays 0) goes to the nearer tip, ``p0`` or ``-beta p0``; a
-    trial beyond the cap or the tensile tip is handled by the same
-    closest-point search; ``p0`` at its floor shrinks the ellipse to a tiny
-    one around ``pc`` (no division by ``p0``); ``p0 <= 0`` (only if
-    ``p0_floor <= 0``) returns the stress-free state; ``beta = 0`` puts the
-    tensile tip at ``p = 0``. ``q_new <= q_tr`` and ``|p_new| <= 41.4 K``, so
-    ``sig_new`` is finite and positive for any finite input.
-    """
-    v3 = vec3(T)
-    s_floor = SINGULAR_VALUE_FLOOR
-    core = camclay_return_strain_func(T)
-
-    @wp.func
-    def camclay_return(sig: v3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T, p0_floor: T):
-        sf = T(s_floor)
-        eps = v3(wp.log(wp.max(sig[0], sf)), wp.log(wp.max(sig[1], sf)), wp.log(wp.max(sig[2], sf)))
-        eps_new, log_jp_new, y = core(eps, log_jp, mu, lam, M, beta, xi, p0_floor)
-        if y == 0:
-            return sig, log_jp, y
-        return v3(wp.exp(eps_new[0]), wp.exp(eps_new[1]), wp.exp(eps_new[2])), log_jp_new, y
-
-    return camclay_return
-
-
-@functools.cache
 def ellipse_point_func(T):
     """Build ``ellipse_point(p_tr, q_tr, p0, K, mu, M, beta) -> (p, q, xu, xv, c, rho, a, sgn)``.
 
     The point ``(p, q)`` (Pa) of the yield ellipse of ``p0`` closest to ``(p_tr, q_tr)`` in the energy
-    metric ``dp^2/K + dq^2/(3 mu)``, for ``a = p0 (1 + beta)/2 > 0`` (the caller's check), with the scaled
-    coordinates it was found in: ``(xu, xv)`` on the unit-``u`` ellipse ``u^2 + v^2/c^2 = 1``
+    metric ``dp^2/K + dq^2/(3 mu)`` (docs/model.md §4), for ``a = p0 (1 + beta)/2 > 0`` (the caller's
+    check), with the scaled coordinates it was found in: ``(xu, xv)`` on the ellipse ``u^2 + v^2/c^2 = 1``
     (``u = |p - pc|/a``, ``v = q/(a rho)``, ``rho = sqrt(3 mu/K)``, ``c = M/(rho sqrt(1 + 2 beta))``) and
     ``sgn`` = -1 when the point is measured from the tensile tip (``p_tr < pc``), +1 else. The one
     projection of :func:`camclay_project_func` and of the bonded return (which needs the scaled point for
@@ -332,9 +236,8 @@ def ellipse_point_func(T):
 def camclay_project_func(T):
     """Build ``camclay_project(p_tr, q_tr, p0, K, mu, M, beta) -> (p_new, q_new)`` (Pa).
 
-    The point of the yield ellipse of ``p0`` closest to a trial ``(p_tr, q_tr)``
-    outside it, in the energy metric ``dp^2/K + dq^2/(3 mu)`` (the projection of
-    :func:`camclay_return_func`, which see; :func:`ellipse_point_func`): stress-free for ``p0 <= 0``.
+    The point of the yield ellipse of ``p0`` closest to a trial ``(p_tr, q_tr)`` outside it, in the
+    energy metric ``dp^2/K + dq^2/(3 mu)`` (:func:`ellipse_point_func`); stress-free for ``p0 <= 0``.
     """
     ellipse_point = ellipse_point_func(T)
 
@@ -351,17 +254,37 @@ def camclay_project_func(T):
 
 @functools.cache
 def camclay_return_strain_func(T):
-    """Build the return mapping in principal Hencky strains, the core of :func:`camclay_return_func`.
+    """Build the Cam-Clay return mapping in principal Hencky strains (docs/model.md §4).
 
     Signature of the returned ``wp.func``::
 
         camclay_return_strain(eps: vec3, log_jp: T, mu: T, lam: T, M: T, beta: T, xi: T,
                               p0_floor: T) -> (eps_new: vec3, log_jp_new: T, yielded: int32)
 
-    ``eps`` are the principal Hencky strains of the trial (-), e.g. ``ln s`` or, with
-    full relative precision for small strains, ``1/2 log1p(lambda)`` of the
-    eigenvalues ``lambda`` of ``F F^T - I`` (``kernels/constitutive.py``). Everything
-    else as :func:`camclay_return_func`; an elastic trial returns ``eps`` itself.
+    Parameters
+    ----------
+    eps : vec3
+        Principal Hencky strains of the trial elastic state (-): ``1/2 log1p`` of the eigenvalues of
+        ``F F^T - I`` (``kernels/principal.py``) or ``ln max(s, SINGULAR_VALUE_FLOOR)`` of its singular values.
+    log_jp : T
+        Hardening state ``ln det F_P`` (-).
+    mu, lam : T
+        Lame parameters (Pa).
+    M, beta, xi : T
+        Slope of the critical state line (> 0), cohesion ratio (>= 0), hardening coefficient (> 0); (-).
+    p0_floor : T
+        Floor of ``p0`` (Pa; e.g. 1e-5 K, above ~1e-20 K so that the scaled trial stays representable).
+
+    Returns
+    -------
+    eps_new : vec3
+        Principal Hencky strains of the new elastic state (-), in the trial's principal directions:
+        ``dev(eps_new) = dev(eps) q_new/q_tr``, ``tr(eps_new) = -p_new/K``. ``eps`` itself, bit for bit,
+        for an elastic trial (``y <= 0``).
+    log_jp_new : T
+        ``log_jp + tr(eps) - tr(eps_new)`` (-): hardening applied after the projection, explicit in ``p0``.
+    yielded : int32
+        1 if the trial was projected, 0 otherwise.
     """
     v3 = vec3(T)
     sqrt6 = _SQRT6

@@ -1,46 +1,11 @@
 """The constitutive update: one Warp function per (dimension, scalar type, material model).
 
-P2G (``kernels/p2g.py``) and the material-point driver (``mpm_warp/material_point.py``)
-both call :func:`constitutive_update_func`, so the driver is the engine's update bit
-for bit. Per particle and step (docs/model.md §1 and 4, SI Note 1):
-
-1. trial state ``F_tr = (I + dt C) F_E``. The elastic state is stored as the
-   displacement gradient ``H = F_E - I`` and the trial is formed as
-   ``H_tr = H + L + L H`` with ``L = dt C`` (:func:`trial_func`): an increment far
-   below float32's resolution of 1 (1e-9 in a settling layer) is kept, where
-   ``(I + L) F`` would round it away and a settled column would creep forever;
-2. small strain (``|F F^T - I|_F <= 0.1``, ``det F > 0``): Hencky strain ``eps`` by its
-   series, no decomposition (``kernels/logstrain.py``). Inside the yield surface (or
-   elastic) that is the answer. A yielding trial takes the return without a
-   decomposition too: the return is isotropic and keeps the direction of
-   ``dev eps``, so it runs on the invariants ``(tr eps, |dev eps|)`` and gives
-   ``eps_new = s dev(eps) + tr(eps_new)/3 I``, coaxial with ``eps``; then
-   ``F_new = exp(eps_new - eps) F_tr``, i.e. ``H_new = H_tr + expm1(D) (I + H_tr)``,
-   ``D = eps_new - eps``, with ``expm1`` of the symmetric ``D`` by its series. This is
-   step 3's update written without ``U`` (``U diag(f(eps_i)) U^T = f(eps)``): the two
-   agree to rounding (``tests/test_coaxial_return.py``) without the decomposition;
-3. otherwise the principal stretches: the eigen-decomposition ``X = U diag(lambda) U^T``
-   of ``X = F F^T - I = H + H^T + H H^T`` (formed from ``H``, so a strain of 1e-6 keeps
-   its relative precision; ``U`` are the left singular vectors of ``F``) gives the
-   principal Hencky strains ``eps_i = 1/2 log1p(lambda_i)``. A stretch below 1e-2 or
-   ``det F_tr <= 0`` takes the SVD instead, with the singular-value floor. For
-   plastic models the return mapping acts on ``eps`` (``kernels/camclay.py``), and
-   the new state is written as a correction of the trial,
-   ``F_new = U diag(exp(eps_new - eps)) U^T F_tr``, i.e.
-   ``H_new = H_tr + U diag(expm1(eps_new - eps)) U^T (I + H_tr)``, so untouched
-   digits stay and a settled layer does not ratchet;
-4. Kirchhoff stress ``tau = U diag(2 mu eps_new + lam tr(eps_new)) U^T``.
-
-Plane strain (``dim = 2``): ``F_E = diag(F_2, F_zz)`` is block diagonal; the
-in-plane block is stored as a 2x2 ``H`` and the out-of-plane stretch as
-``h_zz = F_zz - 1``. The total ``F_zz`` stays 1, but plastic flow changes the
-elastic ``F_zz``, so the return and the Hencky law act on the three principal
-stretches ``(s_1, s_2, 1 + h_zz)`` exactly as in 3D (q with d = 3); only the
-in-plane stress block drives the grid.
-
-Flags returned with the update: :data:`YIELDED` (the return projected),
-:data:`FLOORED` (a singular value was raised to the floor), :data:`INVERTED`
-(``det F_tr <= 0``: an element turned inside out, then floored).
+P2G (``kernels/p2g.py``) and the material-point driver (``mpm_warp/material_point.py``) both call
+:func:`constitutive_update_func`, so the driver is the engine's update bit for bit. From the trial
+displacement gradient ``H_tr = F_tr - I`` it gives the new elastic state, the Kirchhoff stress and the
+hardening; small strains take a decomposition-free path, the rest the principal strains (docs/model.md §4).
+Flags returned with the update: :data:`YIELDED` (the return projected), :data:`FLOORED` (a singular value
+was raised to the floor), :data:`INVERTED` (``det F_tr <= 0``: an element turned inside out, then floored).
 """
 
 import functools

@@ -15,7 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import warp as wp
 
-from .kernels.bonded_camclay import column_sums_zero_kernel, kappa_column_mean_kernel, kappa_column_sum_kernel
+from .kernels.crack_band import column_sums_zero_kernel, kappa_column_mean_kernel, kappa_column_sum_kernel
 from .kernels.g2p import g2p_kernel
 from .kernels.grid_update import grid_update_kernel, wall_state_kernel
 from .kernels.p2g import p2g_kernel

@@ -1,7 +1,7 @@
 """Cam-Clay single material point (docs/validation.md): return mapping and driver.
 
-Tolerances (calibrated on the first runs, then fixed). The returned state is
-stored as singular values ``sig_new = exp(eps_new)``; recomputing ``p, q``
+Tolerances (calibrated on the first runs, then fixed). The probe (``tests/helpers_camclay.py``) gives
+the returned state as singular values ``sig_new = exp(eps_new)``; recomputing ``p, q``
 from them loses about one unit roundoff ``u`` of strain (``u = 2^-24`` in
 float32, ``2^-53`` in float64), growing like ``u (1 + max |eps_i|)`` for large
 strains, i.e. ``K u`` in ``p`` and ``sqrt(6) mu u`` in ``q``; the closest-point
@@ -19,83 +19,18 @@ as 1e-4 M^2 p0^2 is unreachable in float32 when p0 nears its floor (1e-5 K)
 because the strain resolution there is ~1e-7.
 """
 
-import functools
-
 import numpy as np
 import pytest
 import warp as wp
+from helpers_camclay import TYPES, pq_np, run_return, strain_size
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
 
 from mpm_warp.errors import InvalidArgument
-from mpm_warp.kernels.camclay import (
-    SINGULAR_VALUE_FLOOR,
-    camclay_p0_func,
-    camclay_pq_func,
-    camclay_return_func,
-    camclay_yield_func,
-    initial_log_jp,
-)
-from mpm_warp.kernels.elasticity import hencky_func
-from mpm_warp.kernels.types import vec3
+from mpm_warp.kernels.camclay import SINGULAR_VALUE_FLOOR, camclay_p0_func, initial_log_jp
 from mpm_warp.material_point import drive_material_points, isotropic_compression, lame_parameters
 
-TYPES = {"float32": (wp.float32, np.float32, 2.0**-24), "float64": (wp.float64, np.float64, 2.0**-53)}
 YIELD_TOL_U = 8.0
 YIELD_TOL_U_EXTREME = 32.0
-
-
-@functools.cache
-def _probe(T):
-    """Kernel: return mapping of independent states, then p, q, p0, y, Hencky tau."""
-    v3 = vec3(T)
-    ret, pq, p0f = camclay_return_func(T), camclay_pq_func(T), camclay_p0_func(T)
-    yf, hencky = camclay_yield_func(T), hencky_func(T)
-
-    @wp.kernel(enable_backward=False)
-    def probe(sig: wp.array(dtype=v3), ljp: wp.array(dtype=T), par: wp.array2d(dtype=T),
-              sig_out: wp.array(dtype=v3), ljp_out: wp.array(dtype=T), flag: wp.array(dtype=wp.int32),
-              res: wp.array2d(dtype=T), tau: wp.array(dtype=v3)):
-        i = wp.tid()
-        mu, lam, M, beta, xi, pf = par[i, 0], par[i, 1], par[i, 2], par[i, 3], par[i, 4], par[i, 5]
-        s2, l2, y = ret(sig[i], ljp[i], mu, lam, M, beta, xi, pf)
-        sig_out[i] = s2
-        ljp_out[i] = l2
-        flag[i] = y
-        p0 = p0f(ljp[i], lam + T(2.0) / T(3.0) * mu, xi, pf)
-        p, q = pq(s2, mu, lam)
-        res[i, 0] = p
-        res[i, 1] = q
-        res[i, 2] = p0
-        res[i, 3] = yf(p, q, p0, M, beta)
-        tau[i] = hencky(s2, mu, lam, T(SINGULAR_VALUE_FLOOR))
-
-    return probe
-
-
-def run_return(sig, ljp, cases, dtype):
-    """Run the probe kernel; returns dict of numpy arrays (float64 except ``flag``)."""
-    T, nt, _ = TYPES[dtype]
-    n = len(sig)
-    v3 = vec3(T)
-    par = np.stack([cases[k] for k in ("mu", "lam", "M", "beta", "xi", "p0_floor")], axis=1)
-    args = [wp.array(np.asarray(sig, nt), dtype=v3, device=DEVICE), wp.array(np.asarray(ljp, nt), dtype=T,
-            device=DEVICE), wp.array(par.astype(nt), dtype=T, device=DEVICE)]
-    outs = [wp.zeros(n, dtype=v3, device=DEVICE), wp.zeros(n, dtype=T, device=DEVICE),
-            wp.zeros(n, dtype=wp.int32, device=DEVICE), wp.zeros((n, 4), dtype=T, device=DEVICE),
-            wp.zeros(n, dtype=v3, device=DEVICE)]
-    wp.launch(_probe(T), dim=n, inputs=args, outputs=outs, device=DEVICE)
-    sig_out, ljp_out, flag, res, tau = (o.numpy() for o in outs)
-    return {"sig_raw": sig_out, "sig": sig_out.astype(np.float64), "ljp": ljp_out.astype(np.float64),
-            "flag": flag, "p": res[:, 0].astype(np.float64), "q": res[:, 1].astype(np.float64),
-            "p0": res[:, 2].astype(np.float64), "y": res[:, 3].astype(np.float64), "tau": tau.astype(np.float64)}
-
-
-def pq_np(sig, mu, lam):
-    """Reference p, q (Pa) from singular values, float64 (docs/model.md §1)."""
-    eps = np.log(np.maximum(np.asarray(sig, np.float64), SINGULAR_VALUE_FLOOR))
-    tr = eps.sum(axis=-1)
-    dev = eps - tr[..., None] / 3.0
-    return -(lam + 2.0 * mu / 3.0) * tr, np.sqrt(6.0) * mu * np.linalg.norm(dev, axis=-1), dev
 
 
 def random_cases(n, seed=0):
@@ -118,11 +53,6 @@ def random_cases(n, seed=0):
     sig = -np.sort(-sig, axis=1)
     sig[ext, 2] *= np.where(rng.random(ext.sum()) < 0.5, -1.0, 1.0)
     return sig, ljp, c
-
-
-def strain_size(sig):
-    """``1 + max_i |ln sig_i|`` with the same floor as the kernels."""
-    return 1 + np.abs(np.log(np.maximum(np.abs(sig), SINGULAR_VALUE_FLOOR))).max(axis=-1)
 
 
 def yield_scale(c, p0, u, sig):
