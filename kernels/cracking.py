@@ -18,6 +18,7 @@ import functools
 
 import warp as wp
 
+from .principal import jacobi_eig3_func
 from .types import mat, vec3
 
 __all__ = ["damage_func", "crack_func", "crack_principal_func"]
@@ -43,12 +44,14 @@ def crack_func(T, dim):
     """Build ``crack(tau, kappa, t_strength, t_fail) -> (tau', kappa_new, grew)`` on a ``dim x dim`` Kirchhoff stress.
 
     ``grew = 1`` when ``kappa`` rose (the state to store). In 2D (plane strain) the criterion and the
-    softening act on the in-plane principal stresses (closed form); in 3D on those of ``wp.eig3``, which
-    runs only where Gershgorin's bound on the largest principal stress exceeds the threshold.
+    softening act on the in-plane principal stresses (closed form); in 3D on those of the converged Jacobi of
+    ``kernels/principal.py``, which runs only where Gershgorin's bound on the largest principal stress exceeds
+    the threshold.
     """
     M = mat(dim, T)
     V3 = vec3(T)
     damage = damage_func(T)
+    eig3 = jacobi_eig3_func(T)
 
     @wp.func
     def crack(tau: M, kappa: T, t_strength: T, t_fail: T):
@@ -79,7 +82,7 @@ def crack_func(T, dim):
             bound = wp.max(bound, tau[2, 2] + wp.abs(tau[0, 2]) + wp.abs(tau[1, 2]))
             if bound <= threshold and kappa <= t_strength:
                 return tau, kappa, int(0)
-            Q, lam = wp.eig3(tau)
+            Q, lam = eig3(tau)
             s1 = wp.max(lam[0], wp.max(lam[1], lam[2]))
             k_new = kappa
             grew = int(0)
