@@ -132,8 +132,10 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
     elif len(t) and _stalled(t, fr, params):
         cls = "ARR"
         out["arrest_at"] = float(fr[-1])
-        if fr[-1] < cut + params.front.runaway_lead:
+        if fr[-1] <= float(params.saw.cut_length) + 2.0 * params.bin_width:
             out["note"] = "the crack did not run beyond the saw"
+        else:
+            out["note"] = f"the crack ran {fr[-1] - float(params.saw.cut_length):.2f} m beyond the saw and stopped"
     else:
         cls = None
         out["note"] = "the crack was still running when the run ended (lengthen time.end to classify it)"
