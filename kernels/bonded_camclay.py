@@ -88,7 +88,7 @@ xi cosh(xi x) > 1`` and the increment is large), projecting again changes
 nothing, and the bond drops by the work the increment costs. A
 yielding point costs a projection plus two or three (bond) times two
 (volumetric) Newton evaluations: 5.2x camclay's return at a crack tip, 2.5x
-once the bond is gone (CPU, float32, ``benchmarks/bonded_return_cost.py``). The
+once the bond is gone (CPU, float32, ``benchmarks/perf/bonded_return_cost.py``). The
 elastic trial is one yield check and returns its inputs bit for bit.
 
 Numerical constants (fixed, not model parameters): ``SINGULAR_VALUE_FLOOR``

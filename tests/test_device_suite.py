@@ -9,7 +9,7 @@ import sys
 import pytest
 
 BENCH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks")
-sys.path.insert(0, BENCH)
+sys.path[:0] = [os.path.join(BENCH, "perf"), BENCH]
 
 import device_suite  # noqa: E402
 import plastic_block as pb  # noqa: E402

@@ -1,10 +1,10 @@
 """The snow error-against-run-time ladders (issue 14): their two coarsest levels, in CI time.
 
-``benchmarks/error_vs_runtime_snow.py`` halves dx over the shear test of SI Note 2 (3, 6, 12, 24 cells
+``benchmarks/convergence/error_vs_runtime_snow.py`` halves dx over the shear test of SI Note 2 (3, 6, 12, 24 cells
 across its 3 cm layer) and over a flat PST. Here the shear ladder's two coarsest levels run again
 (the whole scene, as the benchmark runs it) and the error of each quantity against the ladder's finest
 level must fall from 3 to 6 cells. The finest level's values are the benchmark's measurement
-(``benchmarks/results/error_vs_runtime_snow.json``, 24 cells, float32, one thread, 2026-11-30: peak
+(``benchmarks/convergence/results/error_vs_runtime_snow.json``, 24 cells, float32, one thread, 2026-11-30: peak
 932.6 Pa, softening slip 2.088 mm (the interior's bond), collapse 0.3055); the coarse values are
 recomputed, so a change to the engine that breaks convergence fails here. (The softening slip is
 read from frames 0.01 mm of push apart: its errors at 3 and 6 cells, 2.2 and 1.6 %, differ by about
@@ -31,7 +31,7 @@ from mpm_warp.scenes.pst import cut_run
 FINEST = {"peak": 932.5898344665492, "delta_s": 0.0020884051965618265, "collapse": 0.3054789884530086}
 
 
-#: the PST ladder's scene (benchmarks/error_vs_runtime_snow.py PST_SCENE): production snow, 2.2 m column
+#: the PST ladder's scene (benchmarks/convergence/error_vs_runtime_snow.py PST_SCENE): production snow, 2.2 m column
 PST_SCENE = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
              "scene.substratum_thickness=0.06", "scene.margin=0.05"]
 #: the PST ladder's finest level (24 cells, dx 2.5 mm, float32, 2026-11-30): error_vs_runtime_snow.json (the collapse
@@ -95,7 +95,7 @@ def _bench():
     import importlib.util
     import os
 
-    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks",
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks", "convergence",
                         "error_vs_runtime_snow.py")
     spec = importlib.util.spec_from_file_location("error_vs_runtime_snow", path)
     mod = importlib.util.module_from_spec(spec)

@@ -28,7 +28,7 @@ Problems (:data:`PROBLEMS`)
 The set-ups, closed forms and measurements are the ones of the validation tests
 (``tests/test_validation_elastic.py``, ``tests/test_weak_layer.py``); the
 derivations are in those tests' docstrings. Every length is in m, time in s,
-stress in Pa, density in kg/m^3. ``benchmarks/error_vs_runtime.py`` runs the
+stress in Pa, density in kg/m^3. ``benchmarks/convergence/error_vs_runtime.py`` runs the
 ladders of ``dx`` and CFL factor.
 """
 

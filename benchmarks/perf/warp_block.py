@@ -22,7 +22,9 @@ import time
 import numpy as np
 import warp as wp
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
 import plastic_block as pb  # noqa: E402
 from common import block_scenario, stage_times  # noqa: E402

@@ -1,14 +1,14 @@
 """The unconfined shear test of SI Note 2 at 4 and 8 cells across the weak layer (issue 10).
 
 Runs ``shear_test`` (the SI's case: the PST's weak layer with the SI's 2 mm softening slip, pushed
-at 0.01 m/s for 0.8 s) at ``D_wl / dx`` = 4 and 8 and writes ``benchmarks/results/snow_shear_test.json``
+at 0.01 m/s for 0.8 s) at ``D_wl / dx`` = 4 and 8 and writes ``benchmarks/snow/results/snow_shear_test.json``
 (peak, residual, softening slip on the layer's own slip and on the plate's displacement, collapse
 beside the oedometric and the critical-state laws, the calibrated targets, and the 4-to-8 changes)
 and ``snow_shear_test.png`` (shear stress and the layer's compaction against its slip, the bond).
 
 Usage::
 
-    .venv/bin/python benchmarks/snow_shear.py
+    .venv/bin/python benchmarks/snow/shear_test.py
 """
 
 from __future__ import annotations
@@ -20,9 +20,11 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
-from common import RESULTS, environment, write_json  # noqa: E402
+from common import environment, write_json  # noqa: E402
 
 import mpm_warp as mw  # noqa: E402
 from mpm_warp.scenes.shear_test import shear_curves  # noqa: E402
@@ -85,7 +87,7 @@ def main(argv=None) -> int:
     change = {k: r8[k] / r4[k] - 1.0 for k in ("peak_shear_stress", "softening_displacement")}
     data = {"runs": runs, "change_4_to_8_cells": change, "si_softening_slip": SI_SLIP, "si_collapse": SI_COLLAPSE,
             "environment": environment(a.device)}
-    write_json("snow_shear_test", data)
+    write_json("snow_shear_test", data, RESULTS)
     figure(runs, os.path.join(RESULTS, "snow_shear_test.png"))
     for r in runs:
         x = r["result"]

@@ -8,11 +8,11 @@ run ``--repeats`` times from that snapshot. Reported per mode: particles, steps 
 process CPU seconds per simulated second (median), particle-steps per CPU second; and the slab/2D ratios.
 One thread each (``MPM_WARP_THREADS=1``), so both get one core; on a shared machine the CPU time is the
 figure to compare (wall time also counts the other users' load). Writes
-``benchmarks/results/pst_plane_strain_cpu.json``.
+``benchmarks/perf/results/pst_plane_strain_cpu.json``.
 
 Usage::
 
-    MPM_WARP_THREADS=1 .venv/bin/python benchmarks/pst_plane_strain.py
+    MPM_WARP_THREADS=1 .venv/bin/python benchmarks/perf/pst_plane_strain.py
 """
 
 from __future__ import annotations
@@ -24,7 +24,9 @@ import sys
 import time
 
 os.environ.setdefault("MPM_WARP_THREADS", "1")
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
 from common import environment, write_json  # noqa: E402
 
@@ -86,7 +88,7 @@ def main(argv=None) -> None:
         "what": "pst_demo physics (dx 7.5 mm, 2 particles per cell and axis, float32) on a shorter column; cost "
                 "of the window after settling (the saw cutting), true 2D against the quasi-2D slab, one thread",
         "scene_overrides": overrides, "window_s": a.window, "repeats": a.repeats, "threads": 1,
-        "modes": res, "slab_over_2d": ratio, "environment": env})
+        "modes": res, "slab_over_2d": ratio, "environment": env}, RESULTS)
     print("wrote", path)
 
 

@@ -13,9 +13,9 @@ hardening rule under uniaxial strain,
 
 ``W`` the slab weight per area (Cauchy), ``lambda_oed`` = 1.0848 for M 1, beta 0.3.
 
-Outputs ``benchmarks/results/mesh_study.json`` (every run, the spread of
+Outputs ``benchmarks/convergence/results/mesh_study.json`` (every run, the spread of
 ``1 - J_P`` across ``dx`` per case, device, versions) and
-``benchmarks/results/mesh_study.png`` (collapse against the load with the
+``benchmarks/convergence/results/mesh_study.png`` (collapse against the load with the
 theoretical curves; error against the number of cells across the layer).
 
 Precision: float64 by default, because in float32 a settled layer creeps by
@@ -35,7 +35,7 @@ dx is up to 29 % over 2-32 cells, 5.8 % over 8-32 and 2.1 % over 16-32. The
 layer interior converges to the closed form (|error| <= 0.2 % at 32 cells).
 float32 at 32 cells: +0.9 % (round-off creep, 3e4 steps) against -0.2 %.
 
-Run: ``python benchmarks/mesh_study.py`` (~5 min on one CPU core);
+Run: ``python benchmarks/convergence/mesh_study.py`` (~5 min on one CPU core);
 ``--quick`` for a two-resolution smoke run; ``--plot-only`` recomputes the
 summary and redraws from the JSON.
 """
@@ -52,7 +52,7 @@ import time
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "tests"))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "tests"))
 
 from test_weak_layer import (  # noqa: E402
     G,

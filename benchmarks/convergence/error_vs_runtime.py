@@ -28,11 +28,11 @@ The snow scenes' ladders (PST critical cut, crack speed, touchdown, collapse;
 shear-test peak, softening slip, collapse) take hours on a CPU and run in
 ``error_vs_runtime_snow.py``.
 
-Outputs ``benchmarks/results/error_vs_runtime.json`` (everything, with the
+Outputs ``benchmarks/convergence/results/error_vs_runtime.json`` (everything, with the
 environment), ``error_vs_runtime.md`` (tables) and ``error_vs_runtime.png``
 (log-log error against wall time; solid: dx ladder, dashed: CFL ladder).
 
-Run: ``python benchmarks/error_vs_runtime.py`` (about 6 min on one CPU core);
+Run: ``python benchmarks/convergence/error_vs_runtime.py`` (about 6 min on one CPU core);
 ``--quick`` for a two-level smoke run; ``--plot-only`` redraws from the JSON.
 """
 
@@ -158,8 +158,8 @@ def pst_estimate() -> dict:
     """Where the snow scenes' ladders are: not here (hours on a CPU), in ``error_vs_runtime_snow.py``."""
     return {"included": False,
             "note": ("the PST (critical cut, crack speed, touchdown, collapse) and shear-test (peak, delta_s, "
-                     "collapse) ladders run in benchmarks/error_vs_runtime_snow.py -> "
-                     "benchmarks/results/error_vs_runtime_snow.{json,png}")}
+                     "collapse) ladders run in benchmarks/convergence/error_vs_runtime_snow.py -> "
+                     "benchmarks/convergence/results/error_vs_runtime_snow.{json,png}")}
 
 
 def plot(data: dict, path: str) -> None:

@@ -14,7 +14,8 @@ its own interpreter (:func:`run_taichi_block_subprocess`).
 
 Command line
 ------------
-``python benchmarks/taichi_peer.py --n-grid 32 --dim 3 --material plastic --steps 50 --arch cpu --threads 1 --json``
+``python benchmarks/perf/taichi_peer.py --n-grid 32 --dim 3 --material plastic --steps 50 --arch cpu --threads 1
+--json``
 prints the result dict of :func:`run_taichi_block` as one JSON line on stdout
 (Taichi's own log lines go to stderr).
 """
@@ -34,7 +35,9 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
 import plastic_block as pb  # noqa: E402
 import taichi_mpm  # noqa: E402

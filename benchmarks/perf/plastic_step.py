@@ -1,8 +1,8 @@
 """The plastic step beside Taichi: the struck Cam-Clay block of ``plastic_block`` in both engines.
 
-Usage: ``python benchmarks/plastic_step.py [--n-grid 32 48 64] [--n-grid-2d 128 256 512] [--steps 50]
+Usage: ``python benchmarks/perf/plastic_step.py [--n-grid 32 48 64] [--n-grid-2d 128 256 512] [--steps 50]
 [--threads 1] [--device cpu]``.
-Writes ``benchmarks/results/plastic_step_<device>.json``.
+Writes ``benchmarks/perf/results/plastic_step_<device>.json``.
 
 For every size both engines run the same scene with the same protocol
 (``warp_block`` / ``taichi_peer``: compiled, warmed up to yield, median of
@@ -30,7 +30,9 @@ import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
 import plastic_block as pb  # noqa: E402
 import warp_block  # noqa: E402
@@ -107,7 +109,7 @@ def main(argv=None) -> int:
            "median_ratio_vs_taichi": {f"{d}d": statistics.median(v) for d, v in ratios.items() if v},
            "median_ratio_vs_taichi_cpu_time": {f"{d}d": statistics.median(v) for d, v in cpu_ratios.items() if v}}
     name = a.name or f"plastic_step_{'cuda' if a.device.startswith('cuda') else 'cpu'}"
-    print("wrote", write_json(name, out))
+    print("wrote", write_json(name, out, RESULTS))
     return 0
 
 

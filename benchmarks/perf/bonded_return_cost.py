@@ -1,7 +1,7 @@
 """Cost of the bonded Cam-Clay return against camclay's, per point, for elastic and yielding trials.
 
-Usage: ``python benchmarks/bonded_return_cost.py [--device cpu|cuda] [--n 1000000] [--precision float32]``.
-Writes ``benchmarks/results/bonded_return_cost_<device>.json``. One kernel launch
+Usage: ``python benchmarks/perf/bonded_return_cost.py [--device cpu|cuda] [--n 1000000] [--precision float32]``.
+Writes ``benchmarks/perf/results/bonded_return_cost_<device>.json``. One kernel launch
 returns ``n`` independent principal states (no SVD: the returns alone), with
 the weak layer of the PST (E 1 MPa, nu 0.3, M 1.2, beta 0.3, xi 0.0041, p_bond
 3058 Pa, kappa_s 0.025: ``mpm_warp.scenes.weak_layer.calibration.weak_layer_material(tau_p=1000,
@@ -19,7 +19,9 @@ import statistics
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
 import numpy as np  # noqa: E402
 import warp as wp  # noqa: E402
@@ -120,7 +122,7 @@ def main(argv=None) -> int:
         print(f"{name:16s} yielded {yielded:5.2f} / {yielded_c:5.2f}: bonded {row['bonded_ns_per_point']:8.1f} ns, "
               f"camclay {row['camclay_ns_per_point']:8.1f} ns per point, ratio {row['ratio']:5.2f}", flush=True)
     path = write_json(f"bonded_return_cost_{dev.alias.split(':')[0]}",
-                      {"environment": environment(a.device), "precision": a.precision, "rows": rows})
+                      {"environment": environment(a.device), "precision": a.precision, "rows": rows}, RESULTS)
     print("wrote", path)
     return 0
 

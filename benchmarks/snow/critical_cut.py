@@ -1,7 +1,7 @@
 """Critical cut length of the PST by bisection on the saw's stop position (issue 10).
 
 Each case bisects :func:`mpm_warp.scenes.pst.critical_cut` on a PST column (trial runs forked from
-one base run, :mod:`mpm_warp.scenes.pst.critical`) and writes ``benchmarks/results/snow_critical_cut.json``
+one base run, :mod:`mpm_warp.scenes.pst.critical`) and writes ``benchmarks/snow/results/snow_critical_cut.json``
 (one entry per case, merged into what is there) and ``snow_critical_cut.png`` (the trials: cut
 against outcome, with the bracket, beside Gaume et al. 2017's formula):
 
@@ -9,7 +9,7 @@ against outcome, with the bracket, beside Gaume et al. 2017's formula):
 - ``slope``: ``pst_slope`` (30 deg) on a 3 m column;
 - ``flat_saw_half``: ``flat`` with the saw at half speed (0.5 m/s);
 - ``ladder_saw_half``: the PST of the error-against-run-time ladder at 6 cells across its layer
-  (``benchmarks/error_vs_runtime_snow.py``, level 1, whose critical cut is the reference) with the saw
+  (``benchmarks/convergence/error_vs_runtime_snow.py``, level 1, whose critical cut is the reference) with the saw
   at half speed: the saw-speed check at a tenth of ``flat_saw_half``'s cost. The dx-halving check is
   that ladder's next level.
 - ``ladder_slope``: that PST on a 30 deg slope (``pst_slope``'s angle), the saw cutting from the
@@ -19,8 +19,8 @@ against outcome, with the bracket, beside Gaume et al. 2017's formula):
 
 Usage::
 
-    nohup .venv/bin/python benchmarks/snow_critical_cut.py flat slope ladder_saw_half ladder_slope > cut.log 2>&1 &
-    .venv/bin/python benchmarks/snow_critical_cut.py     # no case: the figure again from the JSON files
+    nohup .venv/bin/python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope > cut.log 2>&1 &
+    .venv/bin/python benchmarks/snow/critical_cut.py     # no case: the figure again from the JSON files
 """
 
 from __future__ import annotations
@@ -32,9 +32,12 @@ import os
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
+LADDER_RESULTS = os.path.join(os.path.dirname(HERE), "convergence", "results")
 
-from common import RESULTS, environment, write_json  # noqa: E402
+from common import environment, write_json  # noqa: E402
 
 import mpm_warp as mw  # noqa: E402
 from mpm_warp.scenes.pst import critical_cut  # noqa: E402
@@ -78,7 +81,7 @@ def load() -> dict:
 
 def ladder_rows() -> dict:
     """The ladder PST's own bisections (``error_vs_runtime_snow.json``): the references of the ``ladder_*`` cases."""
-    path = os.path.join(RESULTS, "error_vs_runtime_snow.json")
+    path = os.path.join(LADDER_RESULTS, "error_vs_runtime_snow.json")
     if not os.path.isfile(path):
         return {}
     with open(path) as fh:
@@ -124,7 +127,7 @@ def reference(name: str, data: dict) -> float | None:
     """The critical cut at full saw speed (m): the ``flat`` case, or the ladder's level 1 (float32)."""
     if name == "flat":
         return data["cases"].get("flat", {}).get("value")
-    path = os.path.join(RESULTS, "error_vs_runtime_snow.json")
+    path = os.path.join(LADDER_RESULTS, "error_vs_runtime_snow.json")
     if not os.path.isfile(path):
         return None
     with open(path) as fh:
@@ -171,7 +174,7 @@ def main(argv=None) -> int:
             if other in data["cases"] and ref is not None and math.isfinite(ref):
                 data["cases"][other]["reference_value"] = ref
                 data["cases"][other]["change_from_reference"] = data["cases"][other]["value"] / ref - 1.0
-        write_json(OUT, data)
+        write_json(OUT, data, RESULTS)
         figure(data, os.path.join(RESULTS, OUT + ".png"))
     return 0 if all(math.isfinite(c["value"]) for c in data["cases"].values()) else 1
 

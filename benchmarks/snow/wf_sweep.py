@@ -6,13 +6,13 @@ the rest of the layer as ``pst_flat``) one Dask task bisects the critical cut
 error-against-run-time ladder at its 6-cell level (2.2 m column, 0.3 m slab, 6 cm layer, dx 10 mm:
 minutes per case on one core); its base run (the saw to ``hi``) runs on into the far end zone, and
 its mean front speed is the crack speed. Tasks run on a local Dask cluster (one worker process per core, one
-thread each) or on ``--scheduler``. Writes ``benchmarks/results/snow_wf_sweep.json`` and ``.png``
+thread each) or on ``--scheduler``. Writes ``benchmarks/snow/results/snow_wf_sweep.json`` and ``.png``
 (speed and critical cut against ``w_f``, beside the field band, Heierli's speed and Gaume et al.
 2017's critical cut, which does not depend on ``w_f``).
 
 Usage::
 
-    nohup .venv/bin/python benchmarks/snow_wf_sweep.py > wf.log 2>&1 &
+    nohup .venv/bin/python benchmarks/snow/wf_sweep.py > wf.log 2>&1 &
 """
 
 from __future__ import annotations
@@ -23,11 +23,13 @@ import os
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
-from common import RESULTS, dask_map, environment, write_json  # noqa: E402
+from common import dask_map, environment, write_json  # noqa: E402
 
-#: the ladder PST (benchmarks/error_vs_runtime_snow.py) at dx 10 mm, 6 cells across its 6 cm layer
+#: the ladder PST (benchmarks/convergence/error_vs_runtime_snow.py) at dx 10 mm, 6 cells across its 6 cm layer
 COLUMN = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
           "scene.substratum_thickness=0.06", "scene.margin=0.05", "scene.dx=0.01"]
 FIELD_SPEED = (20.0, 30.0)
@@ -107,7 +109,7 @@ def main(argv=None) -> int:
     rows.sort(key=lambda r: r["w_f"])
     data = {"cases": rows, "column": COLUMN, "bracket": [a.lo, a.hi, a.tol], "wall_s": time.perf_counter() - t0,
             "environment": environment(a.device)}
-    write_json("snow_wf_sweep", data)
+    write_json("snow_wf_sweep", data, RESULTS)
     figure(rows, os.path.join(RESULTS, "snow_wf_sweep.png"))
     for r in rows:
         print(f"w_f {r['w_f']:.3g} J/m^2: critical cut {r['critical_cut']:.3g} m [{r['lo']:.3g}, {r['hi']:.3g}] "

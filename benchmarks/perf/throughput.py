@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/throughput.py [--device cpu|cuda:0] [--dims 3 2] [--materials elastic plastic]
+    python benchmarks/perf/throughput.py [--device cpu|cuda:0] [--dims 3 2] [--materials elastic plastic]
                                     [--particles 13824 32768 110592 262144] [--steps 50] [--threads 1 2]
 
 ``--particles`` are approximate counts: each becomes the even ``n_grid`` with
@@ -15,7 +15,7 @@ snapshot; Taichi in its own process per configuration). On the CPU each row
 also has ``cpu_utilisation`` and ``particle_steps_per_cpu_s`` (per second of
 process CPU time): on a machine whose cores are shared with other work the
 wall-clock rates move with that load, the CPU-time rates much less. 2D is plane strain
-(``[domain] dimension = 2`` in mpm_warp). Writes ``benchmarks/results/<name>.json`` (default
+(``[domain] dimension = 2`` in mpm_warp). Writes ``benchmarks/perf/results/<name>.json`` (default
 ``throughput_<device>``) after every configuration, so a run stopped early
 keeps what it measured.
 """
@@ -27,7 +27,9 @@ import os
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
 import plastic_block as pb  # noqa: E402
 import warp_block  # noqa: E402
@@ -104,7 +106,7 @@ def run(dims, materials, particles, steps: int, device: str, threads_list, taich
             t0 = time.perf_counter()
             out["rows"] += measure(dim, material, n, steps, device, nt, taichi, repeats, taichi_timeout_s)
             out["seconds"][f"{dim}d_{material}_{n}_{nt}"] = time.perf_counter() - t0
-            write_json(name, out, results_dir)
+            write_json(name, out, results_dir or RESULTS)
     return out
 
 

@@ -22,19 +22,20 @@ three finest where the observed order allows it (0.5 <= p <= 4, monotone), each 
 5 % and to 1 % error (log-log interpolation along the ladder, or "not reached"). One level is also run
 in float64 (``--precision-level``) to say whether float32 limits a quantity.
 
-Writes ``benchmarks/results/error_vs_runtime_snow.json`` after every level (a killed run keeps the
+Writes ``benchmarks/convergence/results/error_vs_runtime_snow.json`` after every level (a killed run keeps the
 finished levels; a rerun skips them unless ``--redo``) and ``error_vs_runtime_snow.png`` (error
 against wall time, log-log, one line per quantity).
 
 Usage (hours on 2 CPU cores; the finest PST level dominates)::
 
-    nohup .venv/bin/python benchmarks/error_vs_runtime_snow.py > ladder.log 2>&1 &
-    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder shear --levels 0 1   # the two coarsest
-    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --device cuda:0   # on a GPU
-    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --base-only \
+    nohup .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py > ladder.log 2>&1 &
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder shear --levels 0 1   # the two coarsest
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 --device cuda:0  # GPU
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 --base-only \
         --workdir runs/   # the 24-cell base run on the CPU, over several sessions (rerun to resume)
-    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --pst-bracket 0.30625 0.34375 \
-        --workers 2 --threads 2   # its critical cut, bisected where the coarser levels put it (one trial each side)
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 \
+        --pst-bracket 0.30625 0.34375 --workers 2 --threads 2
+        # its critical cut, bisected where the coarser levels put it (one trial each side)
 
 A level run on a GPU records its device and serves as a reference; the wall times to 5 % and 1 % are
 this CPU's only.
@@ -51,9 +52,11 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
-from common import RESULTS, environment, write_json  # noqa: E402
+from common import environment, write_json  # noqa: E402
 
 import mpm_warp as mw  # noqa: E402
 from mpm_warp.memory import estimate_memory  # noqa: E402

@@ -1,7 +1,7 @@
 """A full-resolution Propagation Saw Test: fronts, speed profiles, touchdown, collapse (issue 10).
 
 Runs one PST scene (``pst_flat``, ``pst_slope`` or any PST scenario, with ``--set`` overrides) through
-:func:`mpm_warp.run` and writes ``benchmarks/results/snow_<name>.json`` (every scalar of the scene's
+:func:`mpm_warp.run` and writes ``benchmarks/snow/results/snow_<name>.json`` (every scalar of the scene's
 result, the speed profiles and front paths of the damage and slab-deflection fronts, the frame
 series, the references, the environment and the wall time) and ``snow_<name>.png``:
 
@@ -14,7 +14,7 @@ series, the references, the environment and the wall time) and ``snow_<name>.png
 
 Usage (a long run on the CPU; the run file goes to ``--h5dir``, not to the repository)::
 
-    nohup .venv/bin/python benchmarks/snow_pst.py pst_flat --h5dir /tmp/snow > flat.log 2>&1 &
+    nohup .venv/bin/python benchmarks/snow/pst.py pst_flat --h5dir /tmp/snow > flat.log 2>&1 &
 """
 
 from __future__ import annotations
@@ -27,9 +27,11 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
-from common import RESULTS, environment, write_json  # noqa: E402
+from common import environment, write_json  # noqa: E402
 
 import mpm_warp as mw  # noqa: E402
 
@@ -153,7 +155,7 @@ def main(argv=None) -> int:
              for f in (0.25, 0.5, 0.75)]
     profiles = deflection_profiles(mw.read_run(h5), sc.scene, times)
     res["deflection_profiles"] = profiles
-    write_json(f"snow_{name}", res)
+    write_json(f"snow_{name}", res, RESULTS)
     figure(res, profiles, os.path.join(RESULTS, f"snow_{name}.png"))
     print(f"{name}: wall {wall:.0f} s, {rr.steps} steps, {rr.n_particles} particles; propagated {r['propagated']}, "
           f"speed {r['speed']:.3g} m/s (max {r['damage_speed_max']:.3g}), runaway cut {r['runaway_cut']:.3g} m, "

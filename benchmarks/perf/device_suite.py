@@ -3,13 +3,13 @@
 Usage::
 
     bash benchmarks/device_suite.sh [--device cuda:0] [--quick] [--out DIR] [--parts tests graph ...]
-    python benchmarks/device_suite.py ...            (the same)
+    python benchmarks/perf/device_suite.py ...            (the same)
 
 Every part runs in its own interpreter under its own time budget (a part past
 its budget is killed with its process group and reported as ``timed_out`` with
 what it had written so far); the whole full-mode suite is budgeted below 8
 minutes. Results go to ``<out>/device_suite_<cuda|cpu>[_quick].json``
-(default ``benchmarks/results/``) with the device name, driver and CUDA
+(default ``benchmarks/perf/results/``) with the device name, driver and CUDA
 versions, Warp and Taichi versions, the date, the load average, and the
 seconds each part took beside its budget.
 
@@ -53,8 +53,8 @@ import time
 import xml.etree.ElementTree as ET
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
 
 #: Seconds each part may take: (full, quick). The full budgets sum to 450 s (< 8 min with start-up).
 BUDGETS = {"tests": (120, 60), "graph": (25, 40), "graph_deterministic": (25, 40), "memory": (15, 30),

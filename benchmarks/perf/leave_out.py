@@ -5,7 +5,7 @@ Times the same 110k-particle block (n_grid 48, one CPU thread by default) as
 that stays inside its yield surface (the return is compiled in but only the
 yield check runs), (d) Cam-Clay whose every particle yields every step, and
 reports device bytes per particle of each. Writes
-``benchmarks/results/leave_out_<device>.json``.
+``benchmarks/perf/results/leave_out_<device>.json``.
 """
 
 from __future__ import annotations
@@ -15,7 +15,9 @@ import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
 from common import block_scenario, environment, time_steps, write_json  # noqa: E402
 
@@ -59,7 +61,7 @@ def main(argv=None) -> int:
         r["time_vs_elastic_no_walls"] = r["s_per_step"] / base
     out = {"benchmark": "cost of walls and plasticity on the same block", "n_grid": a.n_grid, "threads": a.threads,
            "environment": environment(a.device), "cases": rows}
-    print("wrote", write_json(f"leave_out_{'cuda' if a.device.startswith('cuda') else 'cpu'}", out))
+    print("wrote", write_json(f"leave_out_{'cuda' if a.device.startswith('cuda') else 'cpu'}", out, RESULTS))
     return 0
 
 

@@ -18,11 +18,11 @@ log-log slopes ``d ln c / d ln E`` and ``d ln c / d ln h_f`` (the measured colla
 reported against Heierli's +1/4 and -1/4.
 
 Cases run as Dask tasks (:func:`common.dask_map`, one worker process per core). Writes
-``benchmarks/results/snow_speed_trends.json`` and ``.png``.
+``benchmarks/snow/results/snow_speed_trends.json`` and ``.png``.
 
 Usage::
 
-    nohup .venv/bin/python benchmarks/snow_speed_trends.py > trends.log 2>&1 &
+    nohup .venv/bin/python benchmarks/snow/speed_trends.py > trends.log 2>&1 &
 """
 
 from __future__ import annotations
@@ -36,10 +36,12 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]  # siblings, and benchmarks/common.py
+RESULTS = os.path.join(HERE, "results")
 
-from common import RESULTS, dask_map, environment, write_json  # noqa: E402
-from snow_wf_sweep import COLUMN, FIELD_SPEED  # noqa: E402
+from common import dask_map, environment, write_json  # noqa: E402
+from wf_sweep import COLUMN, FIELD_SPEED  # noqa: E402
 
 CUT = 0.7                                   # m: the saw's stop, beyond every case's critical cut
 SLAB_E = (1.25e6, 2.5e6, 5.0e6, 7.5e6, 1.0e7)  # Pa
@@ -146,7 +148,7 @@ def main(argv=None) -> int:
                                                (1 if key == "slab.E" else -1) > 0))}
     data = {"trends": trends, "column": COLUMN, "cut": CUT, "h_c_fit": h_fit, "wall_s": time.perf_counter() - t0,
             "environment": environment(a.device)}
-    write_json("snow_speed_trends", data)
+    write_json("snow_speed_trends", data, RESULTS)
     figure(data, os.path.join(RESULTS, "snow_speed_trends.png"))
     for key, t in trends.items():
         print(f"{key}: speed slope {t['slope_speed']:+.3f} (Heierli with the runs' collapse {t['slope_heierli']:+.3f},"
