@@ -1,4 +1,4 @@
-"""Error against run time for the snow scenes: how fine must a PST and a shear test be (issue 14).
+"""Error against run time for the snow scenes: how fine must a PST and a shear test be.
 
 Two ladders of grid spacings (halving; 2 particles per cell and axis and CFL factor 0.4 fixed), on
 this machine's CPU in 2D (plane strain), float32:

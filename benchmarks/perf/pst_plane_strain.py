@@ -1,4 +1,4 @@
-"""Cost of a plane-strain PST per simulated second: true 2D against the quasi-2D slab (issue 11).
+"""Cost of a plane-strain PST per simulated second: true 2D against the quasi-2D slab.
 
 The same PST (``pst_demo``'s physics at its dx of 7.5 mm, on a shorter column) runs in true 2D
 (``scene.plane_strain = "2d"``) and as the quasi-2D slab (``"slab"``: 3D, one cell thick in z between slip

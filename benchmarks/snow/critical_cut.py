@@ -1,4 +1,4 @@
-"""Critical cut length of the PST by bisection on the saw's stop position (issue 10).
+"""Critical cut length of the PST by bisection on the saw's stop position.
 
 Each case bisects :func:`mpm_warp.scenes.pst.critical_cut` on a PST column (trial runs forked from
 one base run, :mod:`mpm_warp.scenes.pst.critical`) and writes ``benchmarks/snow/results/snow_critical_cut.json``
@@ -21,6 +21,7 @@ Usage::
 
     nohup .venv/bin/python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope > cut.log 2>&1 &
     .venv/bin/python benchmarks/snow/critical_cut.py     # no case: the figure again from the JSON files
+    .venv/bin/python benchmarks/snow/critical_cut.py --quick     # one bisection step, to a temporary folder
 """
 
 from __future__ import annotations

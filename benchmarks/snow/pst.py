@@ -1,4 +1,4 @@
-"""A full-resolution Propagation Saw Test: fronts, speed profiles, touchdown, collapse (issue 10).
+"""A full-resolution Propagation Saw Test: fronts, speed profiles, touchdown, collapse.
 
 Runs one PST scene (``pst_flat``, ``pst_slope`` or any PST scenario, with ``--set`` overrides) through
 :func:`mpm_warp.run` and writes ``benchmarks/snow/results/snow_<name>.json`` (every scalar of the scene's
