@@ -1,7 +1,7 @@
 """The one device switch of the test suite.
 
 ``MPM_WARP_TEST_DEVICE`` (default ``"cpu"``) names the Warp device the
-device-meaningful test modules run on; ``benchmarks/device_suite.py`` sets it
+device-meaningful test modules run on; ``benchmarks/perf/device_suite.py`` sets it
 to ``"cuda:0"`` on a GPU machine. ``MPM_WARP_TEST_DETERMINISTIC=1`` switches
 Warp's atomics to its run-to-run deterministic mode (set by ``conftest.py``
 before any kernel module exists): tests that compare two runs bit for bit

@@ -14,11 +14,11 @@ import numpy as np
 from helpers_device import DEVICE  # noqa: F401  (re-exported: MPM_WARP_TEST_DEVICE)
 
 import mpm_warp as mw
+from mpm_warp.studies.convergence import observed_order  # noqa: F401  (re-exported for the tests)
 from mpm_warp.validation import (  # noqa: F401  (re-exported for the tests)
     bar_period,
     com_velocity,
     fixed_free_bar,
-    observed_order,
     zero_crossings,
 )
 

@@ -8,43 +8,53 @@ import sys
 
 import pytest
 
-BENCH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks")
-sys.path.insert(0, BENCH)
+from mpm_warp.studies import plastic_block as pb
+from mpm_warp.studies.blocks import expected_com_y
 
-import device_suite  # noqa: E402
-import plastic_block as pb  # noqa: E402
-from taichi_peer import expected_com_y  # noqa: E402
+SUITE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks", "device_suite.sh")
+
+
+def _suite(*args, timeout=300):
+    return subprocess.run(["bash", SUITE, *args], capture_output=True, text=True, timeout=timeout,
+                          env=dict(os.environ, PYTHON=sys.executable))
+
+
+def plan(quick: bool) -> dict:
+    """The suite's parts, budgets and test modules, as ``device_suite.sh --plan`` prints them."""
+    proc = _suite("--plan", *(["--quick"] if quick else []), timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout)
 
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("suite")
-    proc = subprocess.run(["bash", os.path.join(BENCH, "device_suite.sh"), "--quick", "--device", "cpu",
-                           "--out", str(out)], capture_output=True, text=True, timeout=300,
-                          env=dict(os.environ, PYTHON=sys.executable))
+    proc = _suite("--quick", "--device", "cpu", "--out", str(out))
     assert proc.returncode == 0, proc.stdout + proc.stderr
     with open(out / "device_suite_cpu_quick.json") as fh:
         return json.load(fh), out
 
 
 def test_full_mode_is_budgeted_under_eight_minutes():
-    full = sum(b[0] for b in device_suite.BUDGETS.values())
-    assert full <= 450  # 30 s left for the interpreters' start-up within 8 min
+    full = plan(quick=False)
+    # 30 s left for the interpreters' start-up within 8 min
+    assert full["budget_s_total"] == sum(full["budget_s"].values()) <= 450
 
 
 def test_every_part_ran_within_its_budget(quick):
     res, _ = quick
     env = res["environment"]
     assert env["device"] == "cpu" and env["warp"] and env["date"] and len(env["load_average_1_5_15_min"]) == 3
-    assert set(res["parts"]) == set(device_suite.PARTS)
+    quick_plan = plan(quick=True)
+    assert list(res["parts"]) == quick_plan["parts"] and res["budget_s"] == quick_plan["budget_s"]
     for name, part in res["parts"].items():
         assert part["status"] == "ok", (name, part.get("output_tail"))
-        assert 0 < part["seconds"] <= part["budget_s"] == device_suite.BUDGETS[name][1]
+        assert 0 < part["seconds"] <= part["budget_s"] == quick_plan["budget_s"][name]
 
 
 def test_device_tests_ran_and_passed(quick):
     t = quick[0]["parts"]["tests"]["result"]
-    assert set(t["modules"]) == set(device_suite.QUICK_TEST_MODULES)
+    assert list(t["modules"]) == plan(quick=True)["test_modules"]
     assert t["all_passed"] and t["tests"] >= 9 and t["failures"] == t["errors"] == 0
 
 

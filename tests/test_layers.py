@@ -1,7 +1,8 @@
 """The package imports only downward (docs/architecture.md): no cycle, no upward import, every package installed.
 
 Layers, bottom to top: kernels -> engine -> validation (reference problems) -> scenes -> loader and runner
--> post-processing -> CLI and sweeps -> the package facade ``mpm_warp/__init__.py``. Every ``import`` in
+-> post-processing -> studies (what the benchmarks share) -> CLI and sweeps -> the package facade
+``mpm_warp/__init__.py``. Every ``import`` in
 every module counts, also those inside functions (a late import is still a dependency).
 """
 
@@ -18,7 +19,7 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PACKAGES = {"mpm_warp": "mpm_warp", "mpm_warp.kernels": "kernels"}
-LAYERS = ["kernels", "engine", "validation", "scenes", "scene API", "post", "CLI and sweeps", "facade"]
+LAYERS = ["kernels", "engine", "validation", "scenes", "scene API", "post", "studies", "CLI and sweeps", "facade"]
 
 
 def layer(module: str) -> int:
@@ -37,6 +38,8 @@ def layer(module: str) -> int:
         return LAYERS.index("scene API")
     if top == "post":
         return LAYERS.index("post")
+    if top == "studies":
+        return LAYERS.index("studies")
     if top in ("cli", "sweep", "sweep_summary"):
         return LAYERS.index("CLI and sweeps")
     return LAYERS.index("engine")
@@ -137,7 +140,7 @@ def test_the_checker_sees_upward_imports_and_cycles():
 def test_no_cycle_and_no_upward_import():
     mods = modules()
     assert {"mpm_warp.simulation", "mpm_warp.scenes.pst.monitor", "mpm_warp.kernels.p2g", "mpm_warp.post.fields",
-            "mpm_warp.loader", "mpm_warp.cli"} <= mods.keys()
+            "mpm_warp.loader", "mpm_warp.cli", "mpm_warp.studies.convergence"} <= mods.keys()
     internal, _ = imports(mods)
     assert upward(internal) == []
     assert cycles(internal) == []
@@ -150,6 +153,15 @@ def test_kernels_import_only_warp_the_standard_library_and_kernels():
         if layer(m) == LAYERS.index("kernels"):
             assert all(layer(t) == LAYERS.index("kernels") for t in internal[m]), m
             assert external[m] <= {"warp"} | set(sys.stdlib_module_names), (m, external[m])
+
+
+def test_studies_sit_above_the_scenes_and_below_the_cli():
+    internal, _ = imports(modules())
+    assert layer("mpm_warp.studies.convergence") == LAYERS.index("studies")
+    assert LAYERS.index("scene API") < LAYERS.index("studies") < LAYERS.index("CLI and sweeps")
+    assert internal["mpm_warp.studies.blocks"] >= {"mpm_warp.simulation", "mpm_warp.studies.plastic_block"}
+    assert not any(t.startswith("mpm_warp.studies") for m, ts in internal.items() for t in ts
+                   if not m.startswith("mpm_warp.studies"))      # nothing in the library depends on a study
 
 
 def test_engine_knows_no_scene():

@@ -70,7 +70,7 @@ def test_shear_test_peak_softening_collapse(runs, cells):
     assert ex["residual_shear_stress"] < 0.8 * ex["peak_shear_stress"]
     # collapse beside the laws: more than the oedometric law (q = 0), as sheared snow compacts towards the critical
     # state (p0 = 2 p): 0.23 / 0.25 here at 3.2 mm of push against 0.33 / 0.35 at that pressure (the full 8 mm
-    # of benchmarks/snow_shear.py: 0.27 / 0.29 against 0.24 / 0.25 at its final pressure)
+    # of benchmarks/snow/shear_test.py: 0.27 / 0.29 against 0.24 / 0.25 at its final pressure)
     assert ex["collapse_fraction_law"] < ex["collapse_fraction"] < ex["collapse_fraction_critical_state"] + 0.02
     # displacement control: the plate moves at the push speed once the push has started
     assert c["u"][-1] == pytest.approx(0.01 * (c["t"][-1] - c["t"][0]), rel=0.05)

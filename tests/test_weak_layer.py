@@ -55,7 +55,7 @@ collapse converges at first order in the number of plastic increments
 1e4 increments); the column compacts over ~1e3 steps (2 cells across the
 layer) to ~3e4 (32 cells), so this error is 1e-3 to 3e-5 here.
 
-Findings (CPU; details in the tests and ``benchmarks/mesh_study.py``)
+Findings (CPU; details in the tests and ``benchmarks/convergence/mesh_study.py``)
 --------------------------------------------------------------------
 * Interface cell: the layer under-compacts within about half a cell of the
   slab (one velocity field across a stiff/soft interface; the top particle

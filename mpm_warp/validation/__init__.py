@@ -28,13 +28,14 @@ Problems (:data:`PROBLEMS`)
 The set-ups, closed forms and measurements are the ones of the validation tests
 (``tests/test_validation_elastic.py``, ``tests/test_weak_layer.py``); the
 derivations are in those tests' docstrings. Every length is in m, time in s,
-stress in Pa, density in kg/m^3. ``benchmarks/error_vs_runtime.py`` runs the
-ladders of ``dx`` and CFL factor.
+stress in Pa, density in kg/m^3. ``benchmarks/convergence/error_vs_runtime.py`` runs the
+ladders of ``dx`` and CFL factor; their orders and times to an error are
+:mod:`mpm_warp.studies.convergence`.
 """
 
 from __future__ import annotations
 
-from .common import G, com_velocity, observed_order, zero_crossings
+from .common import G, com_velocity, zero_crossings
 from .elastic import axial_bar, bar_period, column_scenario, fixed_free_bar, self_weight_column
 from .weak_layer import (
     measure_column,
@@ -48,8 +49,7 @@ from .weak_layer import (
 __all__ = [
     "PROBLEMS", "G", "axial_bar", "self_weight_column", "weak_layer_collapse",
     "fixed_free_bar", "bar_period", "column_scenario", "weak_layer_column", "run_column", "measure_column",
-    "oedometric_collapse",
-    "oedometric_state", "com_velocity", "zero_crossings", "observed_order",
+    "oedometric_collapse", "oedometric_state", "com_velocity", "zero_crossings",
 ]
 
 #: the problems by name: ``PROBLEMS[name](dx, cfl=..., dt=..., precision=..., device=...) -> record``

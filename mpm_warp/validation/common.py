@@ -51,11 +51,6 @@ def zero_crossings(t, y, cubic: bool = False) -> np.ndarray:
     return z
 
 
-def observed_order(h, err) -> float:
-    """Slope of ``log(err)`` against ``log(h)`` (least squares, ``np.polyfit``)."""
-    return float(np.polyfit(np.log(np.asarray(h, float)), np.log(np.asarray(err, float)), 1)[0])
-
-
 def _cells(name: str, length: float, dx: float) -> int:
     """``length / dx`` as an integer, or InvalidArgument (blocks must fill whole cells)."""
     if not (isinstance(dx, (int, float)) and math.isfinite(dx) and dx > 0):

@@ -186,7 +186,7 @@ def weak_layer_collapse(dx: float = 1.0 / 256.0, *, cfl: float = 0.4, dt: float 
         Grid spacing (m); ``D_wl / dx`` and ``h_slab / dx`` must be whole numbers
         (binary spacings; the tests use 1/256: 8 cells across the layer).
     cfl, dt, precision, device, n_threads
-        As :func:`axial_bar`. float64 by default, as ``benchmarks/mesh_study.py``.
+        As :func:`axial_bar`. float64 by default, as ``benchmarks/convergence/mesh_study.py``.
     xi : float
         Hardening factor (-).
     rho_slab : float

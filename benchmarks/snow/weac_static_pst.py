@@ -1,10 +1,10 @@
 """weac's static answer for the project's PSTs (mpm_warp.scenes.weac_reference; docs/weac.md §4).
 
-Writes ``benchmarks/results/weac_static_pst.json``:
+Writes ``benchmarks/snow/results/weac_static_pst.json``:
 
-- ``ladder``: the error ladder's PST (benchmarks/error_vs_runtime_snow.py PST_SCENE: 2.2 m column, 0.3 m slab
+- ``ladder``: the error ladder's PST (``mpm_warp.studies.snow.LADDER_PST``: 2.2 m column, 0.3 m slab
   of 250 kg/m^3, E 5 MPa, nu 0.3, on a 6 cm layer of E 1 MPa, nu 0.3; G_c = w_f = 0.79 J/m^2): the energy
-  criterion's critical cut flat and at 30 deg from either end, beside weac 3.3.1's (issue 21), with the mode
+  criterion's critical cut flat and at 30 deg from either end, beside weac 3.3.1's, with the mode
   split of G there, the free end's deflection against weac's collapse height (touchdown), and the cut if the
   weak layer's weight hung on the slab;
 - ``column_ends``: slope-normal against vertical ends for a 0.5 m slab at 35 and 38 deg, from either end, on
@@ -12,7 +12,8 @@ Writes ``benchmarks/results/weac_static_pst.json``:
   (``tan(phi/2)`` where the wedge's centroid gives ``tan(phi)/2``);
 - ``slab_stress``: where the slab's tensile stress peaks at the critical cut.
 
-Usage: ``.venv/bin/python benchmarks/weac_static_pst.py`` (seconds on a CPU; needs ``pip install -e .[weac]``).
+Usage: ``python benchmarks/snow/weac_static_pst.py [--quick]`` (seconds on a CPU; needs
+``pip install -e .[weac]``; the quick mode writes to a temporary folder).
 """
 
 from __future__ import annotations
@@ -23,15 +24,15 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mpm_warp.scenes import weac_reference as wr
+from mpm_warp.scenes.snow import GRAVITY
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
 
-from common import environment, write_json  # noqa: E402
-
-from mpm_warp.scenes import weac_reference as wr  # noqa: E402
-from mpm_warp.scenes.snow import GRAVITY  # noqa: E402
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 W_F = 0.79                                   # J/m^2
-WEAC_3_3_1 = {"flat": 0.380, "downslope_30": 0.382, "upslope_30": 0.452}   # issue 21
+WEAC_3_3_1 = {"flat": 0.380, "downslope_30": 0.382, "upslope_30": 0.452}   # weac 3.3.1, computed independently
 
 
 def column(theta=0.0, cut_from="upslope", ends="slope_normal", h=0.3, L=2.2) -> wr.StaticColumn:
@@ -115,14 +116,15 @@ def slab_stress() -> dict:
     return out
 
 
-def main() -> None:
+def main(argv=None) -> None:
+    a = parser(__doc__, "the same answers (seconds), to a temporary folder").parse_args(argv)
     if wr.weac_unavailable():
         sys.exit(wr.weac_unavailable())
     env = environment("")
     env["weac"] = wr.weac_version()
     data = {"environment": env, "G_c": W_F, "gravity": GRAVITY, "ladder": ladder(), "column_ends": column_ends(),
             "slab_stress": slab_stress()}
-    print(write_json("weac_static_pst", data))
+    print(write_json("weac_static_pst", data, out_dir(a, RESULTS, "weac_static_pst")))
     for k, v in data["ladder"].items():
         print(f"{k}: a_c {v['critical_cut']:.4f} m (weac 3.3.1 {v['weac_3_3_1']}), G_I/G {v['G_I'] / v['G']:.2f}, "
               f"end deflection {v['free_end_deflection_m'] * 1e3:.2f} mm, with the layer's weight "

@@ -1,4 +1,4 @@
-"""Crack speed and critical cut against the weak layer's fracture energy w_f: a Dask sweep (issue 10).
+"""Crack speed and critical cut against the weak layer's fracture energy w_f: a Dask sweep.
 
 For each ``w_f`` (default 0.1, 0.3, 0.79, 1.7 J/m^2: the field's range and the library's default;
 the rest of the layer as ``pst_flat``) one Dask task bisects the critical cut
@@ -6,40 +6,39 @@ the rest of the layer as ``pst_flat``) one Dask task bisects the critical cut
 error-against-run-time ladder at its 6-cell level (2.2 m column, 0.3 m slab, 6 cm layer, dx 10 mm:
 minutes per case on one core); its base run (the saw to ``hi``) runs on into the far end zone, and
 its mean front speed is the crack speed. Tasks run on a local Dask cluster (one worker process per core, one
-thread each) or on ``--scheduler``. Writes ``benchmarks/results/snow_wf_sweep.json`` and ``.png``
+thread each) or on ``--scheduler``. Writes ``benchmarks/snow/results/snow_wf_sweep.json`` and ``.png``
 (speed and critical cut against ``w_f``, beside the field band, Heierli's speed and Gaume et al.
 2017's critical cut, which does not depend on ``w_f``).
 
 Usage::
 
-    nohup .venv/bin/python benchmarks/snow_wf_sweep.py > wf.log 2>&1 &
+    nohup .venv/bin/python benchmarks/snow/wf_sweep.py > wf.log 2>&1 &
+    .venv/bin/python benchmarks/snow/wf_sweep.py --quick      # two cases, to a temporary folder
 """
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.fanout import dask_map
+from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.snow import FIELD_CUT, FIELD_SPEED, ladder_pst
 
-from common import RESULTS, dask_map, environment, write_json  # noqa: E402
-
-#: the ladder PST (benchmarks/error_vs_runtime_snow.py) at dx 10 mm, 6 cells across its 6 cm layer
-COLUMN = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
-          "scene.substratum_thickness=0.06", "scene.margin=0.05", "scene.dx=0.01"]
-FIELD_SPEED = (20.0, 30.0)
-FIELD_CUT = (0.15, 0.6)
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+#: the ladder PST (mpm_warp.studies.snow) at dx 10 mm, 6 cells across its 6 cm layer
+COLUMN = ladder_pst(0.01)
 
 
-def one_case(w_f: float, lo: float, hi: float, tol: float, device: str) -> dict:
+def one_case(w_f: float, lo: float, hi: float, tol: float, device: str, column: list = COLUMN) -> dict:
     """Critical cut and crack speed of pst_flat with fracture energy ``w_f`` (J/m^2): runs in a Dask worker."""
     import mpm_warp as mw
     from mpm_warp.scenes.pst import critical_cut
 
-    sc = mw.load_scenario("pst_flat", COLUMN + [f"scene.weak_layer.w_f={w_f!r}", "scene.weak_layer.delta_s=0.0"])
+    sc = mw.load_scenario("pst_flat", column + [f"scene.weak_layer.w_f={w_f!r}", "scene.weak_layer.delta_s=0.0"])
     t0 = time.perf_counter()
     lines = []
     res = critical_cut(sc, lo, hi, tol=tol, base_run_distance=sc.scene.length, device=device, n_threads=1,
@@ -92,23 +91,27 @@ def figure(rows: list, path: str) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = parser(__doc__, "a 1.2 m column, w_f 0.3 and 0.79 J/m^2, bracket [0.1, 0.5] m bisected once")
     ap.add_argument("--w-f", default="0.1,0.3,0.79,1.7", help="fracture energies (J/m^2), comma separated")
     ap.add_argument("--lo", type=float, default=0.05)
     ap.add_argument("--hi", type=float, default=1.2)
     ap.add_argument("--tol", type=float, default=0.02)
     ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
-    ap.add_argument("--device", default="cpu")
     a = ap.parse_args(argv)
+    if a.quick:
+        a.w_f, a.lo, a.hi, a.tol = "0.3,0.79", 0.1, 0.5, 0.25
     values = [float(v) for v in a.w_f.split(",")]
     t0 = time.perf_counter()
-    rows = dask_map(one_case, [(w, a.lo, a.hi, a.tol, a.device) for w in values], a.workers, a.scheduler)
+    column = COLUMN + ["scene.length=1.2"] if a.quick else COLUMN
+    rows = dask_map(one_case, [(w, a.lo, a.hi, a.tol, a.device, column) for w in values], a.workers, a.scheduler)
     rows.sort(key=lambda r: r["w_f"])
-    data = {"cases": rows, "column": COLUMN, "bracket": [a.lo, a.hi, a.tol], "wall_s": time.perf_counter() - t0,
+    data = {"cases": rows, "column": column, "bracket": [a.lo, a.hi, a.tol], "wall_s": time.perf_counter() - t0,
             "environment": environment(a.device)}
-    write_json("snow_wf_sweep", data)
-    figure(rows, os.path.join(RESULTS, "snow_wf_sweep.png"))
+    name = "snow_wf_sweep" + ("_quick" if a.quick else "")
+    folder = out_dir(a, RESULTS, "wf_sweep")
+    print("wrote", write_json(name, data, folder))
+    figure(rows, os.path.join(folder, name + ".png"))
     for r in rows:
         print(f"w_f {r['w_f']:.3g} J/m^2: critical cut {r['critical_cut']:.3g} m [{r['lo']:.3g}, {r['hi']:.3g}] "
               f"{r['note']}; speed {r['speed']:.3g} m/s (Heierli {r['heierli_speed_run']:.3g}); {r['wall_s']:.0f} s")

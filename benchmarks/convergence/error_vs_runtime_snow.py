@@ -1,4 +1,4 @@
-"""Error against run time for the snow scenes: how fine must a PST and a shear test be (issue 14).
+"""Error against run time for the snow scenes: how fine must a PST and a shear test be.
 
 Two ladders of grid spacings (halving; 2 particles per cell and axis and CFL factor 0.4 fixed), on
 this machine's CPU in 2D (plane strain), float32:
@@ -22,19 +22,24 @@ three finest where the observed order allows it (0.5 <= p <= 4, monotone), each 
 5 % and to 1 % error (log-log interpolation along the ladder, or "not reached"). One level is also run
 in float64 (``--precision-level``) to say whether float32 limits a quantity.
 
-Writes ``benchmarks/results/error_vs_runtime_snow.json`` after every level (a killed run keeps the
+The ladder PST, its levels and bisection grid are :mod:`mpm_warp.studies.snow`; the errors, orders
+and times :mod:`mpm_warp.studies.convergence`.
+
+Writes ``benchmarks/convergence/results/error_vs_runtime_snow.json`` after every level (a killed run keeps the
 finished levels; a rerun skips them unless ``--redo``) and ``error_vs_runtime_snow.png`` (error
 against wall time, log-log, one line per quantity).
 
 Usage (hours on 2 CPU cores; the finest PST level dominates)::
 
-    nohup .venv/bin/python benchmarks/error_vs_runtime_snow.py > ladder.log 2>&1 &
-    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder shear --levels 0 1   # the two coarsest
-    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --device cuda:0   # on a GPU
-    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --base-only \
+    nohup .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py > ladder.log 2>&1 &
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --quick     # 3-cell shear test, to a temp folder
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder shear --levels 0 1   # the two coarsest
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 --device cuda:0  # GPU
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 --base-only \
         --workdir runs/   # the 24-cell base run on the CPU, over several sessions (rerun to resume)
-    .venv/bin/python benchmarks/error_vs_runtime_snow.py --ladder pst --levels 3 --pst-bracket 0.30625 0.34375 \
-        --workers 2 --threads 2   # its critical cut, bisected where the coarser levels put it (one trial each side)
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 \
+        --pst-bracket 0.30625 0.34375 --workers 2 --threads 2
+        # its critical cut, bisected where the coarser levels put it (one trial each side)
 
 A level run on a GPU records its device and serves as a reference; the wall times to 5 % and 1 % are
 this CPU's only.
@@ -42,7 +47,6 @@ this CPU's only.
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -51,35 +55,26 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mpm_warp as mw
+from mpm_warp.errors import InvalidArgument
+from mpm_warp.memory import estimate_memory
+from mpm_warp.scenes.pst import critical_cut
+from mpm_warp.studies.convergence import ladder_summary
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.snow import PST_BRACKET, PST_DX, SHEAR_CELLS, grid_bracket, ladder_pst, merge_pst_parts, pst_part
 
-from common import RESULTS, environment, write_json  # noqa: E402
-
-import mpm_warp as mw  # noqa: E402
-from mpm_warp.memory import estimate_memory  # noqa: E402
-from mpm_warp.scenes.pst import critical_cut  # noqa: E402
-
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 OUT = "error_vs_runtime_snow"
 TARGETS = (0.05, 0.01)
-#: the ladder PST: production snow, 2.2 m column, 0.3 m slab, 6 cm layer (3 cells at the coarsest level)
-PST_SCENE = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
-             "scene.substratum_thickness=0.06", "scene.margin=0.05"]
-PST_DX = [0.02, 0.01, 0.005, 0.0025]
-PST_BRACKET = dict(lo=0.1, hi=0.7, tol=0.02)
-SHEAR_CELLS = [3, 6, 12, 24]
 QUANTITIES = {"pst": ("critical_cut", "speed", "touchdown", "collapse_height"),
               "shear": ("peak", "delta_s", "delta_s_whole_layer", "collapse")}
-#: what a narrowed critical-cut search adds to a level's base-only record
-PST_CUT_FIELDS = ("critical_cut", "critical_cut_bracket", "bracketed", "critical_cut_note", "trials",
-                  "critical_cut_wall_s", "critical_cut_steps", "bisection")
-UNITS = {"critical_cut": "m", "speed": "m/s", "touchdown": "m", "collapse_height": "m", "peak": "Pa",
-         "delta_s": "m", "delta_s_whole_layer": "m", "collapse": "1"}
 
 
 def pst_level(dx: float, precision: str, bracket: dict, device: str, workers: int = 1,
               n_threads: int | None = None) -> dict:
     """One PST level: critical cut by bisection, and the base run's speed, touchdown and collapse height."""
-    sc = mw.load_scenario("pst_flat", PST_SCENE + [f"scene.dx={dx!r}", f'precision="{precision}"'])
+    sc = mw.load_scenario("pst_flat", ladder_pst(dx) + [f'precision="{precision}"'])
     t0 = time.perf_counter()
     res = critical_cut(sc, device=device, base_run_distance=sc.scene.length, base_free_run=0.5, **bracket,
                        workers=workers, n_threads=n_threads,
@@ -99,29 +94,6 @@ def pst_level(dx: float, precision: str, bracket: dict, device: str, workers: in
             "bisection": bracket}
 
 
-def grid_bracket(lo: float, hi: float) -> dict:
-    """A bracket inside :data:`PST_BRACKET` on its bisection grid, for a level whose cut the coarser levels bound.
-
-    ``lo`` and ``hi`` must be points the full search can visit (``PST_BRACKET``'s ``lo`` plus a multiple of its
-    width over a power of two), so that the bisection ends in one of the full search's final brackets:
-    the level's critical cut reads as at the other levels, at the cost of the trials inside ``[lo, hi]``
-    only. A cut outside ``[lo, hi]`` is reported as not bracketed.
-    """
-    b = PST_BRACKET
-    w = b["hi"] - b["lo"]
-    n = 0
-    while w / 2 ** n > b["tol"]:
-        n += 1
-    for name, x in (("lo", lo), ("hi", hi)):
-        k = (x - b["lo"]) / w * 2 ** n
-        if not (b["lo"] <= x <= b["hi"] and abs(k - round(k)) < 1e-6):
-            raise ValueError(f"--pst-bracket {name} = {x} m: not on the bisection grid of {b} "
-                             f"({b['lo']} + k * {w / 2 ** n:g} m, inside [{b['lo']}, {b['hi']}])")
-    if not lo < hi:
-        raise ValueError(f"--pst-bracket: need lo < hi (got {lo}, {hi})")
-    return dict(lo=lo, hi=hi, tol=b["tol"])
-
-
 def pst_cut_level(dx: float, precision: str, bracket: dict, device: str, workers: int,
                   n_threads: int | None) -> dict:
     """A PST level's critical cut searched inside a narrowed ``bracket`` (:func:`grid_bracket`).
@@ -130,7 +102,7 @@ def pst_cut_level(dx: float, precision: str, bracket: dict, device: str, workers
     ladder's (those come from the level's 0.7 m base run, :func:`pst_base_level`): only the critical cut,
     its trials and the search's wall time are returned.
     """
-    sc = mw.load_scenario("pst_flat", PST_SCENE + [f"scene.dx={dx!r}", f'precision="{precision}"'])
+    sc = mw.load_scenario("pst_flat", ladder_pst(dx) + [f'precision="{precision}"'])
     t0 = time.perf_counter()
     res = critical_cut(sc, device=device, **bracket, workers=workers, n_threads=n_threads,
                        log=lambda s: print(f"  pst dx {dx}: {s}", flush=True))
@@ -148,34 +120,6 @@ def pst_cut_level(dx: float, precision: str, bracket: dict, device: str, workers
             "note": "critical cut only (narrowed bracket); the level's base run is a separate --base-only run"}
 
 
-def _part(rec: dict) -> str:
-    """Which runs of a PST level a record holds: ``both``, ``base_run`` or ``critical_cut``."""
-    return rec.get("part") or ("base_run" if rec.get("note", "").startswith("base run only") else "both")
-
-
-def merge_pst_parts(new: dict, old: dict | None) -> dict:
-    """One level's record from its base run (:func:`pst_base_level`) and its narrowed critical-cut search
-    (:func:`pst_cut_level`), run apart in either order; ``old`` is what the JSON holds for the level.
-
-    Once both are there the level's wall time and steps are both runs' (``part``: ``both``); until then
-    the record says which part it holds, and the other part's quantities are nan.
-    """
-    parts = {_part(new): new}
-    if old is not None and _part(old) != "both" and _part(old) != _part(new):
-        parts[_part(old)] = old
-    if len(parts) == 1:
-        return {**new, "part": _part(new)}
-    base, cut = parts["base_run"], parts["critical_cut"]
-    out = {**base, **{k: cut[k] for k in PST_CUT_FIELDS}, "part": "both",
-           "note": "base run (speed, touchdown, collapse height) and critical-cut search (narrowed bracket) run "
-                   "apart: the level's wall time and steps are both runs'",
-           "git_commit_base_run": base.get("git_commit"), "git_commit": cut.get("git_commit"),
-           "wall_time_s": base["wall_time_s"] + cut["critical_cut_wall_s"],
-           "steps": base["steps"] + cut["critical_cut_steps"]}
-    out["particle_steps_per_s"] = out["n_particles"] * out["steps"] / out["wall_time_s"]
-    return out
-
-
 def pst_base_level(dx: float, precision: str, device: str, workdir: str) -> dict | None:
     """One PST level's base run alone (speed, touchdown, collapse height; no critical cut), resumable.
 
@@ -189,7 +133,7 @@ def pst_base_level(dx: float, precision: str, device: str, workdir: str) -> dict
     from mpm_warp.scenes.pst.analysis import end_zone
 
     cut = PST_BRACKET["hi"]
-    sc = mw.load_scenario("pst_flat", PST_SCENE + [f"scene.dx={dx!r}", f'precision="{precision}"',
+    sc = mw.load_scenario("pst_flat", ladder_pst(dx) + [f'precision="{precision}"',
                                                    f"scene.saw.cut_length={cut!r}", "output.checkpoint_every=1",
                                                    "time.frame_interval=0.01"])
     p = sc.scene
@@ -262,66 +206,10 @@ def shear_level(cells: int, precision: str, device: str) -> dict:
             "particle_steps_per_s": rr.particle_steps_per_s}
 
 
-def richardson(h, v):
-    """Richardson extrapolation of the three finest ``(h, v)`` (halving): ``(value, order)`` or ``(nan, p)``."""
-    if len(v) < 3 or not all(np.isfinite(v[-3:])):
-        return math.nan, math.nan
-    a, b, c = v[-3:]
-    if (b - a) == 0 or (c - b) == 0 or (c - b) / (b - a) <= 0:
-        return math.nan, math.nan
-    p = math.log(abs((b - a) / (c - b))) / math.log(2.0)
-    if not 0.5 <= p <= 4.0:
-        return math.nan, p
-    return c + (c - b) / (2.0**p - 1.0), p
-
-
-def time_to(errors, walls, target: float) -> dict:
-    """Wall time (s) to ``target`` error along the ladder (coarse to fine), log-log interpolated."""
-    # CPU wall times only: a level run on a GPU (wall time nan here) still serves as the reference. A level
-    # without a value (a PST whose crack did not run) has not reached any target: its error counts as infinite
-    if not any(np.isfinite(e) for e in errors):
-        return {"status": "no data"}
-    pts = [(e if np.isfinite(e) else math.inf, w) for e, w in zip(errors, walls, strict=True)
-           if np.isfinite(w) or e == 0.0]
-    if pts[0][0] <= target:
-        return {"status": "already at the coarsest", "wall_time_s": pts[0][1]}
-    for k, ((e1, w1), (e2, w2)) in enumerate(zip(pts, pts[1:], strict=False)):
-        if math.isinf(e1) and target >= e2:
-            return {"status": "first met where the quantity first exists", "wall_time_s": w2}
-        if e1 > target >= e2 and e2 > 0:
-            s = (math.log(target) - math.log(e1)) / (math.log(e2) - math.log(e1))
-            return {"status": "interpolated", "wall_time_s": math.exp(math.log(w1) + s * (math.log(w2) - math.log(w1)))}
-        if e1 > target and e2 == 0.0:   # no log-log line to 0: the level that first has no error
-            status = ("at the finest (the reference)" if k + 2 == len(pts)
-                      else "met where the value first equals the finest's")
-            return {"status": status, "wall_time_s": w2 if np.isfinite(w2) else None}
-    return {"status": "not reached", "error_at_finest_compared": pts[-1][0]}
-
-
 def summarise(ladder: str, levels: list[dict]) -> dict:
-    """Errors against the finest level and the Richardson value, orders, times to 5 % and 1 %, per quantity."""
-    out = {}
-    levels = [lv for lv in levels if lv["precision"] == "float32"]
-    if len(levels) < 2:
-        return out
-    walls = [lv["wall_time_s"] if lv.get("device", "cpu") == "cpu" else math.nan for lv in levels]
-    h = [lv["dx"] for lv in levels]
-    for q in QUANTITIES[ladder]:
-        v = np.array([lv[q] if lv[q] is not None else math.nan for lv in levels], float)
-        # the reference is the finest level that has the quantity (a base-run-only level has no critical cut)
-        finite = np.flatnonzero(np.isfinite(v))
-        if len(finite):
-            v = v[:finite[-1] + 1]
-        ref = v[-1]
-        err = np.abs(v / ref - 1.0) if np.isfinite(ref) and ref != 0 else np.full(len(v), math.nan)
-        rich, p = richardson(h[:len(v)], v)
-        err_r = np.abs(v / rich - 1.0) if np.isfinite(rich) else np.full(len(v), math.nan)
-        out[q] = {"values": v.tolist(), "error_vs_finest": err.tolist(), "richardson": rich, "observed_order": p,
-                  "error_vs_richardson": err_r.tolist(), "reference_level": len(v) - 1,
-                  "time_to": {f"{int(100 * t)}%": time_to(list(err_r if np.isfinite(rich) else err), walls[:len(v)], t)
-                              for t in TARGETS},
-                  "reference_used_for_time_to": "richardson" if np.isfinite(rich) else "finest level"}
-    return out
+    """Errors against the finest level and the Richardson value, orders, times to 5 % and 1 %, per quantity
+    (float32 levels; :func:`mpm_warp.studies.convergence.ladder_summary`)."""
+    return ladder_summary([lv for lv in levels if lv["precision"] == "float32"], QUANTITIES[ladder], TARGETS)
 
 
 def figure(data: dict, path: str) -> None:
@@ -374,8 +262,8 @@ def figure(data: dict, path: str) -> None:
     plt.close(fig)
 
 
-def load(results: str = RESULTS) -> dict:
-    path = os.path.join(results, OUT + ".json")
+def load(results: str, name: str = OUT) -> dict:
+    path = os.path.join(results, name + ".json")
     if os.path.isfile(path):
         with open(path) as fh:
             return json.load(fh)
@@ -383,13 +271,11 @@ def load(results: str = RESULTS) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = parser(__doc__, "the shear ladder's coarsest level, 3 cells, float32")
     ap.add_argument("--ladder", choices=["pst", "shear", "both"], default="both")
     ap.add_argument("--levels", type=int, nargs="*", default=None, help="level indices (default all)")
     ap.add_argument("--precision-level", type=int, default=1, help="level also run in float64 (-1: none)")
     ap.add_argument("--redo", action="store_true", help="run levels the JSON already has")
-    ap.add_argument("--device", default="cpu")
-    ap.add_argument("--results", default=RESULTS, help="folder of the JSON and the figure")
     ap.add_argument("--base-only", action="store_true",
                     help="PST: the base run alone (no critical cut), checkpointed in --workdir and resumed by the "
                          "same command after a kill (for the 24-cell level: about 8 h on a 2-core CPU)")
@@ -401,7 +287,16 @@ def main(argv=None) -> int:
                     help="PST critical cut: 2 runs the trials of the bracket's bottom and first midpoint at once")
     ap.add_argument("--threads", type=int, default=None, help="CPU threads of each simulation")
     a = ap.parse_args(argv)
-    data = load(a.results)
+    if a.quick:
+        a.ladder, a.levels, a.precision_level = "shear", [0], -1
+    if a.pst_bracket:
+        try:
+            grid_bracket(*a.pst_bracket)
+        except InvalidArgument as e:
+            ap.error(f"--pst-bracket: {e}")
+    a.results = out_dir(a, RESULTS, OUT)
+    name = OUT + ("_quick" if a.quick else "")
+    data = load(a.results, name)
     data["environment"] = environment(a.device)
     commit = data["environment"].get("git_commit")   # the code this process runs (it may change while it runs)
     ladders = ["shear", "pst"] if a.ladder == "both" else [a.ladder]
@@ -416,7 +311,7 @@ def main(argv=None) -> int:
             done = [x for x in have if x.get("level") == i and x["precision"] == prec]
             want = "critical_cut" if ladder == "pst" and a.pst_bracket else "base_run" if ladder == "pst" and \
                 a.base_only else "both"
-            if done and not a.redo and _part(done[0]) in (want, "both"):
+            if done and not a.redo and pst_part(done[0]) in (want, "both"):
                 continue
             print(f"{ladder} level {i} ({prec})", flush=True)
             if ladder == "pst" and a.pst_bracket:
@@ -434,7 +329,7 @@ def main(argv=None) -> int:
                 rec = shear_level(SHEAR_CELLS[i], prec, a.device)
             rec["level"], rec["device"] = i, a.device     # a level run on a GPU is not a CPU wall time
             rec["git_commit"] = commit                    # levels may come from different runs
-            data = load(a.results)     # merged into what is there now: another process may have written levels
+            data = load(a.results, name)   # merged into what is there now: another process may have written levels
             data["environment"] = environment(a.device)
             have = data["ladders"].setdefault(ladder, [])
             if ladder == "pst" and (a.pst_bracket or a.base_only):    # the level's other part, when there
@@ -443,9 +338,10 @@ def main(argv=None) -> int:
             have[:] = [x for x in have if not (x.get("level") == i and x["precision"] == prec)] + [rec]
             have.sort(key=lambda x: (x["precision"], x["level"]))
             data["summary"] = {k: summarise(k, v) for k, v in data["ladders"].items()}
-            write_json(OUT, data, a.results)
-            figure(data, os.path.join(a.results, OUT + ".png"))
+            write_json(name, data, a.results)
+            figure(data, os.path.join(a.results, name + ".png"))
             print(json.dumps({k: rec[k] for k in rec if k in (*QUANTITIES[ladder], "wall_time_s")}), flush=True)
+    print("results in", a.results, flush=True)
     return 0
 
 

@@ -1,32 +1,30 @@
-"""The unconfined shear test of SI Note 2 at 4 and 8 cells across the weak layer (issue 10).
+"""The unconfined shear test of SI Note 2 at 4 and 8 cells across the weak layer.
 
 Runs ``shear_test`` (the SI's case: the PST's weak layer with the SI's 2 mm softening slip, pushed
-at 0.01 m/s for 0.8 s) at ``D_wl / dx`` = 4 and 8 and writes ``benchmarks/results/snow_shear_test.json``
+at 0.01 m/s for 0.8 s) at ``D_wl / dx`` = 4 and 8 and writes ``benchmarks/snow/results/snow_shear_test.json``
 (peak, residual, softening slip on the layer's own slip and on the plate's displacement, collapse
 beside the oedometric and the critical-state laws, the calibrated targets, and the 4-to-8 changes)
 and ``snow_shear_test.png`` (shear stress and the layer's compaction against its slip, the bond).
 
 Usage::
 
-    .venv/bin/python benchmarks/snow_shear.py
+    .venv/bin/python benchmarks/snow/shear_test.py [--cells 4 8] [--quick]
 """
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mpm_warp as mw
+from mpm_warp.scenes.shear_test import shear_curves
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
 
-from common import RESULTS, environment, write_json  # noqa: E402
-
-import mpm_warp as mw  # noqa: E402
-from mpm_warp.scenes.shear_test import shear_curves  # noqa: E402
-
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 SI_SLIP = 0.002       # m, critical sliding displacement of SI Note 2
 SI_COLLAPSE = 0.20    # -, "almost 20 %" of SI Note 2
 
@@ -77,16 +75,22 @@ def figure(runs: list, path: str) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--device", default="cpu")
+    ap = parser(__doc__, "3 cells across the layer only")
+    ap.add_argument("--cells", type=int, nargs="+", default=[4, 8], help="cells across the weak layer")
     a = ap.parse_args(argv)
-    runs = [run(n, a.device) for n in (4, 8)]
-    r4, r8 = runs[0]["result"], runs[1]["result"]
-    change = {k: r8[k] / r4[k] - 1.0 for k in ("peak_shear_stress", "softening_displacement")}
-    data = {"runs": runs, "change_4_to_8_cells": change, "si_softening_slip": SI_SLIP, "si_collapse": SI_COLLAPSE,
+    if a.quick:
+        a.cells = [3]
+    runs = [run(n, a.device) for n in a.cells]
+    data = {"runs": runs, "si_softening_slip": SI_SLIP, "si_collapse": SI_COLLAPSE,
             "environment": environment(a.device)}
-    write_json("snow_shear_test", data)
-    figure(runs, os.path.join(RESULTS, "snow_shear_test.png"))
+    if len(runs) > 1:
+        lo, hi = runs[0]["result"], runs[-1]["result"]
+        key = f"change_{a.cells[0]}_to_{a.cells[-1]}_cells"
+        data[key] = {k: hi[k] / lo[k] - 1.0 for k in ("peak_shear_stress", "softening_displacement")}
+    name = "snow_shear_test" + ("_quick" if a.quick else "")
+    folder = out_dir(a, RESULTS, "shear_test")
+    print("wrote", write_json(name, data, folder))
+    figure(runs, os.path.join(folder, name + ".png"))
     for r in runs:
         x = r["result"]
         print(f"{r['cells']} cells: peak {x['peak_shear_stress']:.4g} Pa (given {x['tau_p_calibrated']:.4g}), "
@@ -94,7 +98,8 @@ def main(argv=None) -> int:
               f"(plate {1e3 * x['plate_softening_displacement']:.3g} mm), collapse {x['collapse_fraction']:.3f} "
               f"(oedometric {x['collapse_fraction_law']:.3f}, critical state "
               f"{x['collapse_fraction_critical_state']:.3f}), {r['wall_s']:.0f} s")
-    print("4 -> 8 cells:", {k: f"{v:+.2%}" for k, v in change.items()})
+    for key in (k for k in data if k.startswith("change_")):
+        print(key, {k: f"{v:+.2%}" for k, v in data[key].items()})
     return 0
 
 

@@ -1,8 +1,8 @@
 """Cost and accuracy of the 3D principal decomposition: the converged Jacobi of ``kernels/principal.py``
 against ``wp.eig3`` (four float32 / eight float64 sweeps of approximate rotations), per matrix.
 
-Usage: ``python benchmarks/eig3_cost.py [--device cpu|cuda] [--n 200000]``. Writes
-``benchmarks/results/eig3_cost_<device>.json``. The matrices are ``X = F F^T - I`` of the general path:
+Usage: ``python benchmarks/perf/eig3_cost.py [--device cpu|cuda] [--n 200000] [--quick]``. Writes
+``benchmarks/perf/results/eig3_cost_<device>.json``. The matrices are ``X = F F^T - I`` of the general path:
 random rotations of principal values in [-0.9, 2], a quarter with two clustered eigenvalues (relative gaps
 1e-8 to 0.1) and a quarter scaled by 1e-8 to 1. One launch decomposes all of them; the two kernels are
 timed alternately, five times each after a compiling launch, and the medians compared (process CPU time on
@@ -10,21 +10,20 @@ the CPU, wall time on CUDA). Accuracy: the largest off-diagonal of ``Q^T X Q`` o
 largest entry of ``Q^T Q - I``, in rounding units of the precision, against float64 NumPy products.
 """
 
-import argparse
 import functools
 import os
 import statistics
-import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import numpy as np
+import warp as wp
 
-import numpy as np  # noqa: E402
-import warp as wp  # noqa: E402
-from common import environment, write_json  # noqa: E402
+from mpm_warp.kernels.principal import jacobi_eig3_func
+from mpm_warp.kernels.types import mat, vec
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
 
-from mpm_warp.kernels.principal import jacobi_eig3_func  # noqa: E402
-from mpm_warp.kernels.types import mat, vec  # noqa: E402
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 TYPES = {"float32": (wp.float32, np.float32, 2.0**-24), "float64": (wp.float64, np.float64, 2.0**-53)}
 
@@ -66,10 +65,11 @@ def matrices(n: int, seed: int = 0) -> np.ndarray:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--device", default="cpu")
+    ap = parser(__doc__, "2e4 matrices")
     ap.add_argument("--n", type=int, default=200_000)
     a = ap.parse_args(argv)
+    if a.quick:
+        a.n = 20_000
     dev = wp.get_device(a.device)
     clock = time.perf_counter if dev.is_cuda else time.process_time
     X = matrices(a.n)
@@ -105,7 +105,8 @@ def main(argv=None) -> int:
               f"{row['jacobi']['max_offdiag_u']:.3g} / {row['eig3']['max_offdiag_u']:.3g} u, non-orthogonality "
               f"{row['jacobi']['max_nonorthogonality_u']:.3g} / {row['eig3']['max_nonorthogonality_u']:.3g} u",
               flush=True)
-    path = write_json(f"eig3_cost_{dev.alias.split(':')[0]}", {"environment": environment(a.device), "rows": rows})
+    path = write_json(f"eig3_cost_{dev.alias.split(':')[0]}" + ("_quick" if a.quick else ""),
+                      {"environment": environment(a.device), "rows": rows}, out_dir(a, RESULTS, "eig3_cost"))
     print("wrote", path)
     return 0
 

@@ -26,12 +26,19 @@ snapshot and its ``log_Jp``), each loading its inputs and storing its outputs:
 
 The loads and stores make every figure slightly larger than the same work
 inside the fused P2G. On the CPU the figures are process CPU time (one thread).
+
+``plastic_step.py`` calls :func:`update_cost` for every size it times; on its own::
+
+    python benchmarks/perf/return_cost.py [--dim 3] [--n-grid 32] [--repeats 5] [--quick]
+
+measures the struck block (``mpm_warp.studies.plastic_block``) after its warm-up and writes
+``benchmarks/perf/results/return_cost_<device>.json``.
 """
 
 import functools
 import math
-import statistics
-import time
+import os
+import sys
 
 import numpy as np
 import warp as wp
@@ -42,6 +49,13 @@ from mpm_warp.kernels.logstrain import log1p_func, log_strain_func
 from mpm_warp.kernels.principal import principal_strain_func
 from mpm_warp.kernels.types import mat, vec
 from mpm_warp.model import material_params
+from mpm_warp.studies import plastic_block as pb
+from mpm_warp.studies.blocks import block_simulation
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser, result_name
+from mpm_warp.studies.timing import median_launch_time
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 SQRT6 = math.sqrt(6.0)
 
@@ -122,20 +136,6 @@ def _kernels(T, dim):
     return full(True), full(False), series_check, principal, return_only
 
 
-def _median_time(launch, device, repeats: int) -> float:
-    """Median seconds of a launch: process CPU time on the CPU (shared cores), wall time on CUDA."""
-    clock = time.perf_counter if wp.get_device(device).is_cuda else time.process_time
-    launch()  # compile / load
-    wp.synchronize_device(device)
-    ts = []
-    for _ in range(repeats):
-        t0 = clock()
-        launch()
-        wp.synchronize_device(device)
-        ts.append(clock() - t0)
-    return statistics.median(ts)
-
-
 def update_cost(sim, repeats: int = 5) -> dict:
     """Seconds per launch (all particles) of the update and its parts for the current state of ``sim``.
 
@@ -169,22 +169,21 @@ def update_cost(sim, repeats: int = 5) -> dict:
     def outs():
         return [wp.zeros_like(s.H), wp.zeros_like(hzz), wp.zeros_like(s.H), wp.zeros_like(s.log_jp)]
 
-    eng = outs()
-    t_upd = _median_time(lambda: wp.launch(full_update, n, inputs=[*ins, s.log_jp, m, *eng], device=dev), dev,
-                         repeats)
-    ref = outs()
-    t_ref = _median_time(lambda: wp.launch(principal_update, n, inputs=[*ins, s.log_jp, m, *ref], device=dev), dev,
-                         repeats)
+    eng, ref = outs(), outs()
     flags = wp.zeros(n, dtype=wp.int32, device=dev)
     in_range = wp.zeros(n, dtype=wp.int32, device=dev)
-    t_chk = _median_time(lambda: wp.launch(series_check, n, inputs=[*ins, s.log_jp, m, flags, in_range], device=dev),
-                         dev, repeats)
     eps = wp.zeros(n, dtype=vec(3, T), device=dev)
-    t_pri = _median_time(lambda: wp.launch(principal, n, inputs=[*ins, m, eps], device=dev), dev, repeats)
     eps_out, lj_out = wp.zeros_like(eps), wp.zeros_like(s.log_jp)
     yielded = wp.zeros(n, dtype=wp.int32, device=dev)
-    t_ret = _median_time(lambda: wp.launch(return_only, n, inputs=[eps, s.log_jp, m, eps_out, lj_out, yielded],
-                                           device=dev), dev, repeats)
+
+    def timed(kernel, inputs):
+        return median_launch_time(lambda: wp.launch(kernel, n, inputs=inputs, device=dev), dev, repeats)
+
+    t_upd = timed(full_update, [*ins, s.log_jp, m, *eng])
+    t_ref = timed(principal_update, [*ins, s.log_jp, m, *ref])
+    t_chk = timed(series_check, [*ins, s.log_jp, m, flags, in_range])
+    t_pri = timed(principal, [*ins, m, eps])
+    t_ret = timed(return_only, [eps, s.log_jp, m, eps_out, lj_out, yielded])
 
     def maxdiff(a, b):
         return float(np.abs(a.numpy().astype(np.float64) - b.numpy().astype(np.float64)).max())
@@ -196,3 +195,29 @@ def update_cost(sim, repeats: int = 5) -> dict:
             "return_s": t_ret, "series_says_yielding": float(flags.numpy().mean()),
             "series_range_fraction": float(in_range.numpy().mean()),
             "return_yielded": float(yielded.numpy().mean()), "engine_vs_principal_path": diffs}
+
+
+def main(argv=None) -> int:
+    ap = parser(__doc__, "the 3D block at 24 cells")
+    ap.add_argument("--dim", type=int, default=3, choices=(2, 3))
+    ap.add_argument("--n-grid", type=int, default=32, help="cells per axis of the unit box")
+    ap.add_argument("--repeats", type=int, default=5)
+    a = ap.parse_args(argv)
+    if a.quick:
+        a.dim, a.n_grid = 3, 24
+    sim = block_simulation(a.dim, "plastic", a.n_grid, a.device, n_threads=1)
+    sim.stepper.set_frame_end(1e9)
+    sim.stepper.steps(pb.warmup_steps(a.n_grid))     # the state the timed steps of plastic_step see
+    cost = update_cost(sim, a.repeats)
+    print({k: v for k, v in cost.items() if k.endswith("_s")}, flush=True)
+    name = result_name("return_cost", a)
+    data = {"benchmark": "the Cam-Clay update and its parts on the trial states of the struck block, per launch",
+            "dim": a.dim, "n_grid": a.n_grid, "n_particles": sim.model.n_particles, "repeats": a.repeats,
+            "clock": "process CPU time" if not a.device.startswith("cuda") else "wall time", "cost": cost,
+            "environment": environment(a.device)}
+    print("wrote", write_json(name, data, out_dir(a, RESULTS, "return_cost")))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

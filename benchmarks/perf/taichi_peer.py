@@ -1,7 +1,7 @@
 """Taichi peer of the block benchmarks: run ``taichi_mpm`` with the protocol of ``warp_block``.
 
 The scene (2D plane strain or 3D, elastic or Cam-Clay) is defined in
-``taichi_mpm.py`` and ``plastic_block.py``; this module runs it: ``ti.init``,
+``taichi_mpm.py`` and :mod:`mpm_warp.studies.blocks`; this module runs it: ``ti.init``,
 compile, ``warmup`` untimed steps, snapshot, then ``repeats`` repeats that
 each restore the snapshot and time ``steps`` steps; the median is reported.
 On the CPU the faster of the atomic and serialized P2G scatters is picked by a
@@ -14,7 +14,8 @@ its own interpreter (:func:`run_taichi_block_subprocess`).
 
 Command line
 ------------
-``python benchmarks/taichi_peer.py --n-grid 32 --dim 3 --material plastic --steps 50 --arch cpu --threads 1 --json``
+``python benchmarks/perf/taichi_peer.py --n-grid 32 --dim 3 --material plastic --steps 50 --arch cpu --threads 1
+--json``
 prints the result dict of :func:`run_taichi_block` as one JSON line on stdout
 (Taichi's own log lines go to stderr).
 """
@@ -34,11 +35,10 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import taichi_mpm
 
-import plastic_block as pb  # noqa: E402
-import taichi_mpm  # noqa: E402
-from taichi_mpm import ELASTIC_DT, GRAVITY_Y, block_positions  # noqa: E402,F401  (re-exported)
+from mpm_warp.studies import plastic_block as pb
+from mpm_warp.studies.blocks import default_warmup, expected_com_y, initial_state
 
 _ARCH_NAMES = ("cpu", "cuda", "gpu", "vulkan", "metal", "opengl")
 
@@ -46,20 +46,6 @@ _ARCH_NAMES = ("cpu", "cuda", "gpu", "vulkan", "metal", "opengl")
 def taichi_available() -> bool:
     """Whether ``import taichi`` would find a module (without importing it)."""
     return importlib.util.find_spec("taichi") is not None
-
-
-def expected_com_y(steps: int, dt: float = ELASTIC_DT, y0: float = 0.5) -> float:
-    """Centre-of-mass height of the freely falling elastic block after ``steps`` steps from rest.
-
-    MLS-MPM conserves linear momentum and the block does not reach the walls
-    in a short run, so symplectic Euler gives ``y0 + g dt^2 steps (steps + 1) / 2``.
-    """
-    return y0 + GRAVITY_Y * dt * dt * steps * (steps + 1) / 2.0
-
-
-def default_warmup(material: str, n_grid: int) -> int:
-    """Untimed steps before timing (the same as ``warp_block.default_warmup``)."""
-    return pb.warmup_steps(n_grid) if material == "plastic" else 3
 
 
 def _time_kernel(ti: Any, scene, kernel, snap: dict, steps: int, repeats: int) -> tuple[list[float], list[float]]:
@@ -140,7 +126,7 @@ def run_taichi_block(n_grid: int, steps: int, arch: str = "cpu", cpu_max_num_thr
     plastic = material == "plastic"
     mode = "plastic" if plastic else "elastic"
     candidates = (["atomic", "serial"] if on_cpu else ["atomic"]) if p2g_scatter == "auto" else [p2g_scatter]
-    x0, v0, C0 = taichi_mpm.initial_state(n_grid, dim, material)
+    x0, v0, C0 = initial_state(n_grid, dim, material)
     modes = [mode] + (["plastic_track"] if plastic and diagnostics else []) + (["no_return"] if return_share else [])
     for name in candidates:  # compile every kernel outside the timings
         for m in modes:

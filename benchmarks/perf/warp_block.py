@@ -8,74 +8,22 @@ report the median. The observables are those of the state after the last
 repeat, i.e. after ``warmup + steps`` steps from the start. Cam-Clay runs also
 record, for every timed step (replayed from the snapshot with the ``yielded``
 output on), the fractions of particles whose return was active and of cap and
-dry-side returns (``plastic_block.return_kinds``).
+dry-side returns (:func:`mpm_warp.studies.plastic_block.return_kinds`). The scenes are
+:mod:`mpm_warp.studies.blocks`.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import os
 import statistics
-import sys
 import time
 
 import numpy as np
 import warp as wp
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-
-import plastic_block as pb  # noqa: E402
-from common import block_scenario, stage_times  # noqa: E402
-
-import mpm_warp  # noqa: E402
-
-
-def plastic_material() -> mpm_warp.CamClaySnow:
-    """The Cam-Clay snow of ``plastic_block``."""
-    return mpm_warp.CamClaySnow(pb.YOUNG_E, pb.POISSON_NU, pb.DENSITY, M=pb.M_CSL, beta=pb.BETA, xi=pb.XI,
-                                p0_ini=pb.P0_INI, p0_floor_ratio=pb.P0_FLOOR_RATIO)
-
-
-def block_simulation(dim: int, material: str, n_grid: int, device: str = "cpu", n_threads: int | None = 1,
-                     track_yield: bool = False, elastic_twin: bool = False) -> mpm_warp.Simulation:
-    """The block of the throughput benchmarks as an mpm_warp Simulation.
-
-    Parameters
-    ----------
-    dim : {2, 3}
-        2 is plane strain (``[domain] dimension = 2``).
-    material : {"elastic", "plastic"}
-        The elastic block (``common.block_scenario``) or the struck Cam-Clay
-        block of ``plastic_block`` (its ``v`` and exact ``C`` assigned).
-    n_grid : int
-        Cells per axis of the unit box (``n_grid**dim`` particles).
-    track_yield : bool
-        Cam-Clay only: keep the ``yielded`` output field (diagnostics).
-    elastic_twin : bool
-        Cam-Clay scene with an elastic material of the same E, nu, rho: the
-        same step with plasticity compiled out (no yield check, no return).
-    """
-    if dim not in (2, 3):
-        raise ValueError(f"dim must be 2 or 3, got {dim}")
-    if material == "elastic":
-        return mpm_warp.Simulation(block_scenario(n_grid, dim=dim), device=device, n_threads=n_threads)
-    if material != "plastic":
-        raise ValueError(f"material must be 'elastic' or 'plastic', got {material!r}")
-    pb.check_n_grid(n_grid)
-    mat = mpm_warp.Elastic(pb.YOUNG_E, pb.POISSON_NU, pb.DENSITY) if elastic_twin else plastic_material()
-    sc = block_scenario(n_grid, material=mat, dt=pb.time_step(n_grid), dim=dim)
-    if track_yield:
-        sc = dataclasses.replace(sc, output=mpm_warp.Output(fields=("x", "yielded")))
-    sim = mpm_warp.Simulation(sc, device=device, n_threads=n_threads)
-    x0 = sim.state.x.numpy()
-    sim.state.v.assign(pb.initial_velocity(x0).astype(sim.model.np_dtype))
-    sim.state.C.assign(pb.initial_velocity_gradient(x0).astype(sim.model.np_dtype))
-    return sim
-
-
-def default_warmup(material: str, n_grid: int) -> int:
-    """Untimed steps before timing: 3 for the elastic block, ``plastic_block.warmup_steps`` for Cam-Clay."""
-    return pb.warmup_steps(n_grid) if material == "plastic" else 3
+import mpm_warp
+from mpm_warp.studies import plastic_block as pb
+from mpm_warp.studies.blocks import block_simulation, default_warmup
+from mpm_warp.studies.timing import stage_times
 
 
 def _timed(sim: mpm_warp.Simulation, snap: dict, steps: int, repeats: int) -> tuple[list[float], list[float]]:

@@ -2,9 +2,10 @@
 
 A weak layer (``D_wl`` = 3.125 cm, Cam-Clay, E 0.2 MPa, nu 0.3, rho 150,
 M 1, beta 0.3, p0_ini 0) under an elastic slab in a laterally confined column,
-gravity ramped (``tests/test_weak_layer.py``: set-up, closed form and
-measurements). For every grid spacing ``dx``, hardening factor ``xi`` and slab
-density (which sets the load and so ``p0``, as the paper did) the settled
+gravity ramped (:func:`mpm_warp.validation.weak_layer_column`: set-up,
+closed form and measurements; tests in ``tests/test_weak_layer.py``). For
+every grid spacing ``dx``, hardening factor ``xi`` and slab density (which
+sets the load and so ``p0``, as the paper did) the settled
 column gives the mean collapse ``1 - J_P`` of the layer and the collapse height
 ``h_c = (1 - J_P) D_wl``; they are compared with the closed form of the
 hardening rule under uniaxial strain,
@@ -13,9 +14,9 @@ hardening rule under uniaxial strain,
 
 ``W`` the slab weight per area (Cauchy), ``lambda_oed`` = 1.0848 for M 1, beta 0.3.
 
-Outputs ``benchmarks/results/mesh_study.json`` (every run, the spread of
+Outputs ``benchmarks/convergence/results/mesh_study.json`` (every run, the spread of
 ``1 - J_P`` across ``dx`` per case, device, versions) and
-``benchmarks/results/mesh_study.png`` (collapse against the load with the
+``benchmarks/convergence/results/mesh_study.png`` (collapse against the load with the
 theoretical curves; error against the number of cells across the layer).
 
 Precision: float64 by default, because in float32 a settled layer creeps by
@@ -35,14 +36,13 @@ dx is up to 29 % over 2-32 cells, 5.8 % over 8-32 and 2.1 % over 16-32. The
 layer interior converges to the closed form (|error| <= 0.2 % at 32 cells).
 float32 at 32 cells: +0.9 % (round-off creep, 3e4 steps) against -0.2 %.
 
-Run: ``python benchmarks/mesh_study.py`` (~5 min on one CPU core);
-``--quick`` for a two-resolution smoke run; ``--plot-only`` recomputes the
-summary and redraws from the JSON.
+Run: ``python benchmarks/convergence/mesh_study.py`` (~5 min on one CPU core);
+``--quick`` for a two-resolution smoke run (to a temporary folder); ``--plot-only``
+recomputes the summary and redraws from the JSON.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -51,33 +51,25 @@ import time
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "tests"))
+import mpm_warp as mw
+from mpm_warp.materials import hardening_collapse
+from mpm_warp.studies.convergence import observed_order
+from mpm_warp.studies.environment import environment
+from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.validation import G, oedometric_collapse, oedometric_ratio, run_column, weak_layer_column
 
-from test_weak_layer import (  # noqa: E402
-    G,
-    hardening_collapse,
-    oedometric_collapse,
-    oedometric_ratio,
-    run_column,
-    weak_layer_column,
-)
-
-import mpm_warp as mw  # noqa: E402
-from mpm_warp.result import versions  # noqa: E402
-
-RESULTS = os.path.join(HERE, "results")
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 DEFAULT_CELLS = (2, 4, 8, 16, 32)  # cells across the weak layer: dx = D_wl / cells
 DEFAULT_XI = (0.02, 0.04, 0.08)
 DEFAULT_RHO_SLAB = (600.0, 1200.0, 2400.0)  # slab 6.25 cm thick: W = 368, 736, 1472 Pa
 D_WL = 1.0 / 32.0
 
 
-def run_case(cells: int, xi: float, rho_slab: float, precision: str) -> dict:
+def run_case(cells: int, xi: float, rho_slab: float, precision: str, device: str = "cpu") -> dict:
     """One settled column; returns the JSON record (no per-particle arrays)."""
     dx = D_WL / cells
     t0 = time.perf_counter()
-    m, sim, info = run_column(dx=dx, xi=xi, rho_slab=rho_slab, precision=precision, D_wl=D_WL)
+    m, sim, info = run_column(dx=dx, xi=xi, rho_slab=rho_slab, precision=precision, D_wl=D_WL, device=device)
     total = time.perf_counter() - t0
     m.pop("per_particle")
     rec = {"cells": cells, "dx": dx, "xi": xi, "rho_slab": rho_slab, "precision": precision, **m,
@@ -105,7 +97,7 @@ def summarise(runs: list[dict]) -> list[dict]:
             return float((v.max() - v.min()) / v.mean()) if len(v) > 1 else None
 
         fit = [(r["dx"], abs(r["error"])) for r in rs if r["cells"] >= 4 and r["error"] != 0.0]
-        order = float(np.polyfit(*np.log(np.array(fit)).T, 1)[0]) if len(fit) > 1 else None
+        order = observed_order(*zip(*fit, strict=True)) if len(fit) > 1 else None
         out.append({
             "xi": xi, "rho_slab": rho, "precision": prec, "W_mean": rs[0]["W_mean"],
             "collapse_theory": rs[0]["collapse_theory"],
@@ -193,34 +185,33 @@ def plot(data: dict, path: str) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = parser(__doc__, "4 and 8 cells, one xi, one slab density")
     ap.add_argument("--cells", type=int, nargs="+", default=list(DEFAULT_CELLS))
     ap.add_argument("--xi", type=float, nargs="+", default=list(DEFAULT_XI))
     ap.add_argument("--rho-slab", type=float, nargs="+", default=list(DEFAULT_RHO_SLAB))
     ap.add_argument("--precision", default="float64", choices=("float32", "float64"))
     ap.add_argument("--float32-case", type=float, nargs=2, default=(0.04, 1200.0), metavar=("XI", "RHO_SLAB"),
                     help="repeat this case in float32 at every dx (xi, slab density); 0 0 to skip")
-    ap.add_argument("--quick", action="store_true", help="cells 4 8, one xi, one density")
-    ap.add_argument("--out", default=os.path.join(RESULTS, "mesh_study.json"))
-    ap.add_argument("--png", default=os.path.join(RESULTS, "mesh_study.png"))
-    ap.add_argument("--plot-only", action="store_true")
+    ap.add_argument("--plot-only", action="store_true",
+                    help="recompute the summary and redraw the figure from the JSON in --out (or the results)")
     a = ap.parse_args(argv)
+    name = "mesh_study" + ("_quick" if a.quick else "")
+    folder = (a.out or RESULTS) if a.plot_only else out_dir(a, RESULTS, "mesh_study")
+    path, png = os.path.join(folder, name + ".json"), os.path.join(folder, name + ".png")
     if a.plot_only:
-        with open(a.out) as fh:
+        with open(path) as fh:
             data = json.load(fh)
         data["summary"] = summarise(data["runs"])
-        with open(a.out, "w") as fh:
-            json.dump(data, fh, indent=1)
-        plot(data, a.png)
+        _write(path, data)
+        plot(data, png)
         report(data)
         return 0
     if a.quick:
         a.cells, a.xi, a.rho_slab = [4, 8], [0.04], [1200.0]
-    os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
     sc, wl, info = weak_layer_column(dx=D_WL / 8, xi=a.xi[0], rho_slab=a.rho_slab[0], D_wl=D_WL)
     data = {
-        "benchmark": "mesh_study", "source": "Gaume et al. 2018 SI Note 3; tests/test_weak_layer.py",
-        "device": "cpu", "precision": a.precision, "versions": versions(),
+        "benchmark": "mesh_study", "source": "Gaume et al. 2018 SI Note 3; mpm_warp.validation.weak_layer_column",
+        "device": a.device, "precision": a.precision, "environment": environment(a.device),
         "threads": 1,
         "set_up": {"D_wl": D_WL, "h_slab": info["h_slab"], "rho_wl": info["rho_wl"],
                    "slab": {**sc.materials["slab"].to_dict(), "density": "per run (rho_slab)"}, "gravity": G,
@@ -237,19 +228,26 @@ def main(argv=None) -> int:
         jobs += [(c, a.float32_case[0], a.float32_case[1], "float32") for c in a.cells]
     t_all = time.perf_counter()
     for k, (c, xi, rho, prec) in enumerate(jobs):
-        rec = run_case(c, xi, rho, prec)
+        rec = run_case(c, xi, rho, prec, a.device)
         data["runs"].append(rec)
         data["summary"] = summarise(data["runs"])
         data["wall_time_study"] = time.perf_counter() - t_all
-        with open(a.out, "w") as fh:
-            json.dump(data, fh, indent=1)
+        _write(path, data)
         print(f"[{k + 1}/{len(jobs)}] cells {c:3d} xi {xi:g} rho_s {rho:g} {prec}: 1-J_P {rec['collapse']:.5f} "
               f"theory {rec['collapse_theory']:.5f} err {100 * rec['error']:+.2f} % (interior "
               f"{100 * rec['error_interior']:+.2f} %), h_c {1e3 * rec['h_c']:.3f} mm, {rec['steps']} steps, "
               f"{rec['wall_time_total']:.1f} s", flush=True)
-    plot(data, a.png)
+    plot(data, png)
     report(data)
+    print("wrote", path, flush=True)
     return 0
+
+
+def _write(path: str, data: dict) -> None:
+    """The JSON through a temporary file (a kill leaves the previous one)."""
+    with open(path + ".tmp", "w") as fh:
+        json.dump(data, fh, indent=1)
+    os.replace(path + ".tmp", path)
 
 
 def report(data: dict) -> None:

@@ -1,7 +1,7 @@
-"""A full-resolution Propagation Saw Test: fronts, speed profiles, touchdown, collapse (issue 10).
+"""A full-resolution Propagation Saw Test: fronts, speed profiles, touchdown, collapse.
 
 Runs one PST scene (``pst_flat``, ``pst_slope`` or any PST scenario, with ``--set`` overrides) through
-:func:`mpm_warp.run` and writes ``benchmarks/results/snow_<name>.json`` (every scalar of the scene's
+:func:`mpm_warp.run` and writes ``benchmarks/snow/results/snow_<name>.json`` (every scalar of the scene's
 result, the speed profiles and front paths of the damage and slab-deflection fronts, the frame
 series, the references, the environment and the wall time) and ``snow_<name>.png``:
 
@@ -14,12 +14,12 @@ series, the references, the environment and the wall time) and ``snow_<name>.png
 
 Usage (a long run on the CPU; the run file goes to ``--h5dir``, not to the repository)::
 
-    nohup .venv/bin/python benchmarks/snow_pst.py pst_flat --h5dir /tmp/snow > flat.log 2>&1 &
+    nohup .venv/bin/python benchmarks/snow/pst.py pst_flat --h5dir /tmp/snow > flat.log 2>&1 &
+    .venv/bin/python benchmarks/snow/pst.py --quick     # a small PST, results to a temporary folder
 """
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import sys
@@ -27,14 +27,14 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mpm_warp as mw
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.snow import FIELD_SPEED, ladder_pst
 
-from common import RESULTS, environment, write_json  # noqa: E402
-
-import mpm_warp as mw  # noqa: E402
-
-FIELD_SPEED = (20.0, 30.0)  # m/s, PST crack speeds (Bergfeld et al. 2021; docs/model.md §6)
-FIELD_TOUCHDOWN = 2.7       # m, PST touchdown distance (Bergfeld et al. 2021; docs/model.md §6)
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+#: --quick: the ladder PST at 6 cells across its layer (dx 1 cm) on a 1.5 m column, sawn to 0.5 m, to 0.6 s
+QUICK = ladder_pst(0.01) + ["scene.length=1.5", "scene.saw.cut_length=0.5", "time.end=0.6"]
 
 
 def _plt():
@@ -113,19 +113,24 @@ def figure(res: dict, profiles: list[dict], path: str) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scene", help="a PST scenario: pst_flat, pst_slope, or a file")
+    ap = parser(__doc__, "pst_flat as the ladder PST at 6 cells (dx 1 cm) on a 1.5 m column, sawn to 0.5 m, to 0.6 s")
+    ap.add_argument("scene", nargs="?", default=None, help="a PST scenario: pst_flat, pst_slope, or a file "
+                                                           "(--quick: pst_flat)")
     ap.add_argument("--set", dest="overrides", action="append", default=[], help="scenario override KEY=VALUE")
     ap.add_argument("--name", default=None, help="result name (default: the scenario's name)")
     ap.add_argument("--h5dir", default=os.environ.get("TMPDIR", "/tmp"), help="folder of the run file")
-    ap.add_argument("--device", default="cpu")
     ap.add_argument("--resume", action="store_true",
                     help="continue an interrupted run of this scene in --h5dir from its checkpoint")
     ap.add_argument("--prior-wall-s", type=float, default=0.0,
                     help="with --resume: wall seconds the interrupted part ran (added to the reported wall time)")
     a = ap.parse_args(argv)
+    if a.quick:
+        a.scene, a.overrides = a.scene or "pst_flat", QUICK + a.overrides
+    if a.scene is None:
+        ap.error("a PST scenario is needed (or --quick)")
     sc = mw.load_scenario(a.scene, a.overrides)
-    name = a.name or sc.name
+    name = (a.name or sc.name) + ("_quick" if a.quick else "")
+    folder = out_dir(a, RESULTS, "pst")
     os.makedirs(a.h5dir, exist_ok=True)
     h5 = os.path.join(a.h5dir, f"snow_{name}.h5")
     print(sc.scene.calibrated().describe(), flush=True)
@@ -153,8 +158,8 @@ def main(argv=None) -> int:
              for f in (0.25, 0.5, 0.75)]
     profiles = deflection_profiles(mw.read_run(h5), sc.scene, times)
     res["deflection_profiles"] = profiles
-    write_json(f"snow_{name}", res)
-    figure(res, profiles, os.path.join(RESULTS, f"snow_{name}.png"))
+    print("wrote", write_json(f"snow_{name}", res, folder), flush=True)
+    figure(res, profiles, os.path.join(folder, f"snow_{name}.png"))
     print(f"{name}: wall {wall:.0f} s, {rr.steps} steps, {rr.n_particles} particles; propagated {r['propagated']}, "
           f"speed {r['speed']:.3g} m/s (max {r['damage_speed_max']:.3g}), runaway cut {r['runaway_cut']:.3g} m, "
           f"touchdown {r['touchdown']:.3g} m (Heierli {r['heierli_touchdown_run']:.3g}), front agreement "

@@ -1,7 +1,7 @@
-"""Critical cut length of the PST by bisection on the saw's stop position (issue 10).
+"""Critical cut length of the PST by bisection on the saw's stop position.
 
 Each case bisects :func:`mpm_warp.scenes.pst.critical_cut` on a PST column (trial runs forked from
-one base run, :mod:`mpm_warp.scenes.pst.critical`) and writes ``benchmarks/results/snow_critical_cut.json``
+one base run, :mod:`mpm_warp.scenes.pst.critical`) and writes ``benchmarks/snow/results/snow_critical_cut.json``
 (one entry per case, merged into what is there) and ``snow_critical_cut.png`` (the trials: cut
 against outcome, with the bracket, beside Gaume et al. 2017's formula):
 
@@ -9,7 +9,7 @@ against outcome, with the bracket, beside Gaume et al. 2017's formula):
 - ``slope``: ``pst_slope`` (30 deg) on a 3 m column;
 - ``flat_saw_half``: ``flat`` with the saw at half speed (0.5 m/s);
 - ``ladder_saw_half``: the PST of the error-against-run-time ladder at 6 cells across its layer
-  (``benchmarks/error_vs_runtime_snow.py``, level 1, whose critical cut is the reference) with the saw
+  (``benchmarks/convergence/error_vs_runtime_snow.py``, level 1, whose critical cut is the reference) with the saw
   at half speed: the saw-speed check at a tenth of ``flat_saw_half``'s cost. The dx-halving check is
   that ladder's next level.
 - ``ladder_slope``: that PST on a 30 deg slope (``pst_slope``'s angle), the saw cutting from the
@@ -19,32 +19,33 @@ against outcome, with the bracket, beside Gaume et al. 2017's formula):
 
 Usage::
 
-    nohup .venv/bin/python benchmarks/snow_critical_cut.py flat slope ladder_saw_half ladder_slope > cut.log 2>&1 &
-    .venv/bin/python benchmarks/snow_critical_cut.py     # no case: the figure again from the JSON files
+    nohup .venv/bin/python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope > cut.log 2>&1 &
+    .venv/bin/python benchmarks/snow/critical_cut.py     # no case: the figure again from the JSON files
+    .venv/bin/python benchmarks/snow/critical_cut.py --quick     # one bisection step, to a temporary folder
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mpm_warp as mw
+from mpm_warp.scenes.pst import critical_cut
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.snow import FIELD_CUT, ladder_pst
 
-from common import RESULTS, environment, write_json  # noqa: E402
-
-import mpm_warp as mw  # noqa: E402
-from mpm_warp.scenes.pst import critical_cut  # noqa: E402
-
-FIELD_CUT = (0.15, 0.6)   # m: the issue's band for a flat PST (field: a few tens of centimetres)
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "results")
+#: the error ladder's results (benchmarks/convergence/): its PST's own bisections are the ladder cases' references
+LADDER_RESULTS = os.path.join(os.path.dirname(HERE), "convergence", "results")
 #: the column of the bisections: 3 m leaves 1 m of run beyond a 0.8 m cut and the slab's end zone
 COLUMN = ["scene.length=3.0", "scene.marker_spacing=0.1"]
 #: the PST of the error-against-run-time ladder at its level 1 (dx 10 mm, 6 cells across a 6 cm layer)
-LADDER = ["scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
-          "scene.substratum_thickness=0.06", "scene.margin=0.05", "scene.dx=0.01"]
+LADDER = ladder_pst(0.01)
 CASES = {
     "flat": ("pst_flat", COLUMN, dict(lo=0.1, hi=0.8, tol=0.02)),
     "slope": ("pst_slope", COLUMN, dict(lo=0.05, hi=0.8, tol=0.02)),
@@ -54,6 +55,8 @@ CASES = {
     "ladder_slope_cut_downslope_end": ("pst_slope", LADDER + ["scene.slope_angle=-30.0"],
                                        dict(lo=0.05, hi=0.7, tol=0.02)),
 }
+#: --quick: the ladder PST on a 1.2 m column bisected once (bracket [0.1, 0.5] m to 0.25 m: the base run, 2 trials)
+QUICK = ("pst_flat", LADDER + ["scene.length=1.2"], dict(lo=0.1, hi=0.5, tol=0.25))
 OUT = "snow_critical_cut"
 
 
@@ -66,8 +69,8 @@ def _plt():
     return plt
 
 
-def load() -> dict:
-    path = os.path.join(RESULTS, OUT + ".json")
+def load(folder: str) -> dict:
+    path = os.path.join(folder, OUT + ".json")
     if os.path.isfile(path):
         with open(path) as fh:
             data = json.load(fh)
@@ -78,7 +81,7 @@ def load() -> dict:
 
 def ladder_rows() -> dict:
     """The ladder PST's own bisections (``error_vs_runtime_snow.json``): the references of the ``ladder_*`` cases."""
-    path = os.path.join(RESULTS, "error_vs_runtime_snow.json")
+    path = os.path.join(LADDER_RESULTS, "error_vs_runtime_snow.json")
     if not os.path.isfile(path):
         return {}
     with open(path) as fh:
@@ -87,7 +90,7 @@ def ladder_rows() -> dict:
     for lv in levels:
         if lv["precision"] == "float32" and lv.get("bracketed"):
             lo, hi = lv["critical_cut_bracket"]
-            sc = mw.load_scenario("pst_flat", LADDER[:-1] + [f"scene.dx={lv['dx']!r}"])
+            sc = mw.load_scenario("pst_flat", ladder_pst(lv["dx"]))
             label = f"ladder, dx {1e3 * lv['dx']:g} mm (error ladder)"
             if lv.get("bisection", {}).get("narrowed_from"):
                 label = label[:-1] + ", narrowed)"
@@ -124,7 +127,7 @@ def reference(name: str, data: dict) -> float | None:
     """The critical cut at full saw speed (m): the ``flat`` case, or the ladder's level 1 (float32)."""
     if name == "flat":
         return data["cases"].get("flat", {}).get("value")
-    path = os.path.join(RESULTS, "error_vs_runtime_snow.json")
+    path = os.path.join(LADDER_RESULTS, "error_vs_runtime_snow.json")
     if not os.path.isfile(path):
         return None
     with open(path) as fh:
@@ -134,7 +137,7 @@ def reference(name: str, data: dict) -> float | None:
 
 
 def run_case(name: str, data: dict, device: str) -> dict:
-    scene, overrides, bracket = CASES[name]
+    scene, overrides, bracket = QUICK if name == "quick" else CASES[name]
     sc = mw.load_scenario(scene, overrides)
     t0 = time.perf_counter()
     res = critical_cut(sc, device=device, log=lambda s: print(f"{name}: {s}", flush=True), **bracket)
@@ -152,27 +155,29 @@ def run_case(name: str, data: dict, device: str) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = parser(__doc__, "the ladder PST at 6 cells on a 1.2 m column, bisected once: a base run and two trials")
     ap.add_argument("cases", nargs="*", help=f"any of {', '.join(CASES)} (none: redraw the figure)")
-    ap.add_argument("--device", default="cpu")
     a = ap.parse_args(argv)
     bad = [c for c in a.cases if c not in CASES]
     if bad:
         ap.error(f"unknown case(s) {', '.join(bad)}: choose from {', '.join(CASES)}")
-    data = load()
+    if a.quick:
+        a.cases = ["quick"]
+    folder = (a.out or RESULTS) if not a.cases else out_dir(a, RESULTS, "critical_cut")
+    data = load(folder)
     if not a.cases:                   # the figure again, from the JSON files as they are
-        figure(data, os.path.join(RESULTS, OUT + ".png"))
+        figure(data, os.path.join(folder, OUT + ".png"))
         return 0
     for name in a.cases:
         case = run_case(name, data, a.device)
-        data = load()                 # merged into what is there now: another process may have written a case
+        data = load(folder)           # merged into what is there now: another process may have written a case
         data["cases"][name] = case
         for other, ref in (("flat_saw_half", reference("flat", data)), ("ladder_saw_half", reference("ladder", data))):
             if other in data["cases"] and ref is not None and math.isfinite(ref):
                 data["cases"][other]["reference_value"] = ref
                 data["cases"][other]["change_from_reference"] = data["cases"][other]["value"] / ref - 1.0
-        write_json(OUT, data)
-        figure(data, os.path.join(RESULTS, OUT + ".png"))
+        print("wrote", write_json(OUT, data, folder), flush=True)
+        figure(data, os.path.join(folder, OUT + ".png"))
     return 0 if all(math.isfinite(c["value"]) for c in data["cases"].values()) else 1
 
 

@@ -15,10 +15,10 @@ longer than ``--repeat-limit`` seconds is run once only (stated per run as
 ``runs`` in the outputs). The errors are deterministic (checked: the spread
 over repeats is stored).
 
-Per problem it reports the observed order in ``dx`` (``np.polyfit`` of
+Per problem it reports the observed order in ``dx`` (least-squares slope of
 ``log error`` on ``log dx`` over the ladder), the slope of ``log error`` against
 ``log wall time``, and the wall time needed for 1 % error, interpolated in
-log-log between the two ladder runs that bracket it ("already below at
+log-log between the two ladder runs that bracket it ("already at the
 coarsest" or "not reached" otherwise, with the numbers). For the CFL ladder,
 whose error is dominated by the spatial error, it also gives the change of the
 measured quantity against the smallest CFL factor (an estimate of the time-
@@ -28,29 +28,29 @@ The snow scenes' ladders (PST critical cut, crack speed, touchdown, collapse;
 shear-test peak, softening slip, collapse) take hours on a CPU and run in
 ``error_vs_runtime_snow.py``.
 
-Outputs ``benchmarks/results/error_vs_runtime.json`` (everything, with the
-environment), ``error_vs_runtime.md`` (tables) and ``error_vs_runtime.png``
+Outputs ``benchmarks/convergence/results/error_vs_runtime.json`` (everything, with the
+environment record), ``error_vs_runtime.md`` (tables) and ``error_vs_runtime.png``
 (log-log error against wall time; solid: dx ladder, dashed: CFL ladder).
 
-Run: ``python benchmarks/error_vs_runtime.py`` (about 6 min on one CPU core);
-``--quick`` for a two-level smoke run; ``--plot-only`` redraws from the JSON.
+Run: ``python benchmarks/convergence/error_vs_runtime.py`` (about 6 min on one CPU core);
+``--quick`` for a two-level smoke run (to a temporary folder); ``--plot-only`` redraws from the JSON.
+The convergence arithmetic (orders, time to an error) is :mod:`mpm_warp.studies.convergence`.
 """
 
 from __future__ import annotations
 
-import argparse
-import datetime
 import json
 import math
 import os
-import platform
 import statistics
 import sys
 import time
 
 from mpm_warp.errors import SimulationBlowUp
-from mpm_warp.result import versions
-from mpm_warp.validation import PROBLEMS, observed_order
+from mpm_warp.studies.convergence import observed_order, time_to_target
+from mpm_warp.studies.environment import environment
+from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.validation import PROBLEMS
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 TARGET = 0.01
@@ -112,25 +112,6 @@ def timed_case(name: str, dx: float, cfl: float, precision: str, device: str, n_
     return out
 
 
-def time_to_target(runs: list[dict], target: float = TARGET) -> dict:
-    """Wall time (s) for ``error = target`` along the dx ladder (coarse to fine), interpolated in log-log."""
-    rs = [r for r in runs if _ok(r)]
-    if not rs:
-        return {"status": "no valid runs"}
-    if rs[0]["error"] < target:
-        return {"status": "already below at coarsest", "error": rs[0]["error"], "wall_time_s": rs[0]["wall_time_s"],
-                "dx": rs[0]["dx"]}
-    for a, b in zip(rs, rs[1:], strict=False):
-        if a["error"] >= target > b["error"]:
-            s = (math.log(target) - math.log(a["error"])) / (math.log(b["error"]) - math.log(a["error"]))
-            t = math.exp(math.log(a["wall_time_s"]) + s * (math.log(b["wall_time_s"]) - math.log(a["wall_time_s"])))
-            dx = math.exp(math.log(a["dx"]) + s * (math.log(b["dx"]) - math.log(a["dx"])))
-            return {"status": "interpolated", "wall_time_s": t, "dx": dx,
-                    "between": [{"dx": r["dx"], "error": r["error"], "wall_time_s": r["wall_time_s"]} for r in (a, b)]}
-    f = rs[-1]
-    return {"status": "not reached", "error": f["error"], "wall_time_s": f["wall_time_s"], "dx": f["dx"]}
-
-
 def summarise(name: str, dx_runs: list[dict], dt_runs: list[dict]) -> dict:
     """Observed orders, error-time slope, time to 1 % error, time-stepping error of the CFL ladder."""
     ok = [r for r in dx_runs if _ok(r)]
@@ -139,7 +120,7 @@ def summarise(name: str, dx_runs: list[dict], dt_runs: list[dict]) -> dict:
                                        if len(ok) > 2 else None),
          "error_time_slope": (observed_order([r["wall_time_s"] for r in ok], [r["error"] for r in ok])
                               if len(ok) > 1 else None),
-         "time_to_1pct": time_to_target(ok)}
+         "time_to_1pct": time_to_target(ok, TARGET)}
     okt = sorted((r for r in dt_runs if r.get("error") is not None), key=lambda r: -r["cfl"])
     if okt:
         ref = okt[-1]
@@ -158,8 +139,8 @@ def pst_estimate() -> dict:
     """Where the snow scenes' ladders are: not here (hours on a CPU), in ``error_vs_runtime_snow.py``."""
     return {"included": False,
             "note": ("the PST (critical cut, crack speed, touchdown, collapse) and shear-test (peak, delta_s, "
-                     "collapse) ladders run in benchmarks/error_vs_runtime_snow.py -> "
-                     "benchmarks/results/error_vs_runtime_snow.{json,png}")}
+                     "collapse) ladders run in benchmarks/convergence/error_vs_runtime_snow.py -> "
+                     "benchmarks/convergence/results/error_vs_runtime_snow.{json,png}")}
 
 
 def plot(data: dict, path: str) -> None:
@@ -255,34 +236,26 @@ def markdown(data: dict) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = parser(__doc__, "the two coarsest dx, CFL 0.4 and 0.2, one run each")
     ap.add_argument("--problems", nargs="+", default=list(LADDERS), choices=list(LADDERS))
-    ap.add_argument("--device", default="cpu")
     ap.add_argument("--threads", type=int, default=1, help="CPU threads of the step (1: comparable, shared machine)")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--repeat-limit", type=float, default=120.0,
                     help="run a case once only when its first run takes longer than this (s)")
-    ap.add_argument("--quick", action="store_true", help="two coarsest dx, CFL 0.4 and 0.2, one run each")
-    ap.add_argument("--out", default=os.path.join(RESULTS, "error_vs_runtime.json"))
-    ap.add_argument("--plot-only", action="store_true")
+    ap.add_argument("--plot-only", action="store_true", help="redraw the figure and tables from the JSON in --out")
     a = ap.parse_args(argv)
-    if a.quick and a.out == ap.get_default("out"):
-        a.out = os.path.join(RESULTS, "error_vs_runtime_quick.json")
-    stem = os.path.splitext(a.out)[0]
+    name = "error_vs_runtime" + ("_quick" if a.quick else "")
+    folder = (a.out or RESULTS) if a.plot_only else out_dir(a, RESULTS, "error_vs_runtime")
+    path, stem = os.path.join(folder, name + ".json"), os.path.join(folder, name)
     if a.plot_only:
-        with open(a.out) as fh:
+        with open(path) as fh:
             data = json.load(fh)
         plot(data, stem + ".png")
         with open(stem + ".md", "w") as fh:
             fh.write(markdown(data))
         return 0
-    os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
-    v = versions()
-    data = {"benchmark": "error_vs_runtime", "date": datetime.date.today().isoformat(),
-            "environment": {"device": a.device, "n_threads": a.threads,
-                            "cpu": platform.processor() or platform.machine(),
-                            "cpu_count": os.cpu_count(), "warp": v["warp"], "mpm_warp": v["mpm_warp"],
-                            "numpy": v["numpy"], "python": v["python"]},
+    env = environment(a.device)
+    data = {"benchmark": "error_vs_runtime", "date": env["date"][:10], "environment": {**env, "n_threads": a.threads},
             "settings": {"cfl_dx_ladder": CFL, "cfl_ladder": list(DT_LADDER_CFL), "particles_per_cell_per_axis": 2,
                          "repeats": a.repeats, "repeat_limit_s": a.repeat_limit, "target_error": TARGET},
             "problems": {}, "pst": pst_estimate()}
@@ -306,14 +279,15 @@ def main(argv=None) -> int:
                   f"(runs {r['runs']}), steps {r.get('steps')}, particles {r.get('n_particles')}", flush=True)
             p["summary"] = summarise(name, p["dx_ladder"], p["dt_ladder"])
             data["wall_time_benchmark_s"] = time.perf_counter() - t_all
-            with open(a.out, "w") as fh:
+            with open(path + ".tmp", "w") as fh:
                 json.dump(data, fh, indent=1, default=float)
+            os.replace(path + ".tmp", path)
         s = p["summary"]
         print(f"{name}: order in dx {_f(s['observed_order_dx'])}, time to 1 %: {s['time_to_1pct']}", flush=True)
     plot(data, stem + ".png")
     with open(stem + ".md", "w") as fh:
         fh.write(markdown(data))
-    print(f"done in {time.perf_counter() - t_all:.0f} s: {a.out}", flush=True)
+    print(f"done in {time.perf_counter() - t_all:.0f} s: {path}", flush=True)
     return 0
 
 

@@ -1,8 +1,8 @@
-"""The plastic step beside Taichi: the struck Cam-Clay block of ``plastic_block`` in both engines.
+"""The plastic step beside Taichi: the struck Cam-Clay block (``mpm_warp.studies.plastic_block``) in both engines.
 
-Usage: ``python benchmarks/plastic_step.py [--n-grid 32 48 64] [--n-grid-2d 128 256 512] [--steps 50]
-[--threads 1] [--device cpu]``.
-Writes ``benchmarks/results/plastic_step_<device>.json``.
+Usage: ``python benchmarks/perf/plastic_step.py [--n-grid 32 48 64] [--n-grid-2d 128 256 512] [--steps 50]
+[--threads 1] [--device cpu] [--quick]``.
+Writes ``benchmarks/perf/results/plastic_step_<device>.json``.
 
 For every size both engines run the same scene with the same protocol
 (``warp_block`` / ``taichi_peer``: compiled, warmed up to yield, median of
@@ -12,9 +12,9 @@ process). Each row records:
 * particle-steps/s of both and their ratio, by wall clock and per second of
   process CPU time (robust when other work shares the cores);
 * the return kinds of every timed step in both engines (fraction yielding, cap
-  and dry-side returns), checked against ``plastic_block.check_return_kinds``;
+  and dry-side returns), checked against ``mpm_warp.studies.plastic_block.check_return_kinds``;
 * the observables after the same steps (mean p, mean q, mean log_Jp, mean
-  |log_Jp - log_Jp(0)|) and whether they agree within ``plastic_block.AGREEMENT``;
+  |log_Jp - log_Jp(0)|) and whether they agree within ``mpm_warp.studies.plastic_block.AGREEMENT``;
 * where the time goes: mpm_warp per stage (one thread), its step with
   plasticity compiled out (an elastic material of the same E, nu, rho on the
   same state), and its constitutive update and the update's parts alone on
@@ -25,25 +25,27 @@ process). Each row records:
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import warp_block
+from return_cost import update_cost
+from taichi_peer import run_taichi_block_subprocess
 
-import plastic_block as pb  # noqa: E402
-import warp_block  # noqa: E402
-from common import environment, write_json  # noqa: E402
-from return_cost import update_cost  # noqa: E402
-from taichi_peer import run_taichi_block_subprocess  # noqa: E402
+from mpm_warp.studies import plastic_block as pb
+from mpm_warp.studies.blocks import block_simulation
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser, result_name
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 
 def compare_size(dim: int, n_grid: int, steps: int, threads: int, device: str, repeats: int, taichi: bool) -> dict:
     """One size: mpm_warp and Taichi rows, ratio, agreement and where the time goes."""
     w = warp_block.run_block(dim, "plastic", n_grid, steps, device=device, n_threads=threads, repeats=repeats,
                              stages=True, diagnostics=True, return_share=True)
-    sim = warp_block.block_simulation(dim, "plastic", n_grid, device, n_threads=1)
+    sim = block_simulation(dim, "plastic", n_grid, device, n_threads=1)
     sim.stepper.set_frame_end(1e9)
     sim.stepper.steps(w["warmup"])
     cost = update_cost(sim)
@@ -82,8 +84,7 @@ def compare_size(dim: int, n_grid: int, steps: int, threads: int, device: str, r
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--device", default="cpu")
+    ap = parser(__doc__, "3D at 24 cells and 2D at 48, 5 steps, one repeat")
     ap.add_argument("--n-grid", type=int, nargs="+", default=[32, 48, 64], help="3D sizes (cells per axis)")
     ap.add_argument("--n-grid-2d", type=int, nargs="*", default=[128, 256, 512], help="2D (plane strain) sizes")
     ap.add_argument("--steps", type=int, default=50)
@@ -92,22 +93,24 @@ def main(argv=None) -> int:
     ap.add_argument("--no-taichi", action="store_true")
     ap.add_argument("--name", default=None, help="result file name (default plastic_step_<device>)")
     a = ap.parse_args(argv)
+    if a.quick:
+        a.n_grid, a.n_grid_2d, a.steps, a.repeats = [24], [48], 5, 1
     env = environment(a.device)
     sizes = [(3, n) for n in a.n_grid] + [(2, n) for n in a.n_grid_2d]
     rows = [compare_size(d, n, a.steps, a.threads, a.device, a.repeats, not a.no_taichi) for d, n in sizes]
     ratios = {d: [r["ratio_vs_taichi"] for r in rows if r["dim"] == d and "ratio_vs_taichi" in r] for d in (3, 2)}
     cpu_ratios = {d: [r["ratio_vs_taichi_cpu_time"] for r in rows if r["dim"] == d and "ratio_vs_taichi_cpu_time" in r]
                   for d in (3, 2)}
-    out = {"benchmark": "plastic step beside Taichi: struck Cam-Clay snow block (plastic_block.py), 3D and 2D "
-                        "(plane strain), float32",
+    out = {"benchmark": "plastic step beside Taichi: struck Cam-Clay snow block (mpm_warp.studies.plastic_block), "
+                        "3D and 2D (plane strain), float32",
            "scene": {"material": {"E": pb.YOUNG_E, "nu": pb.POISSON_NU, "density": pb.DENSITY, "M": pb.M_CSL,
                                   "beta": pb.BETA, "xi": pb.XI, "p0_ini": pb.P0_INI},
                      "impact_speed": pb.IMPACT_SPEED, "strain_rate": pb.strain_rate(), "cfl": pb.CFL},
            "environment": env, "steps": a.steps, "repeats": a.repeats, "rows": rows,
            "median_ratio_vs_taichi": {f"{d}d": statistics.median(v) for d, v in ratios.items() if v},
            "median_ratio_vs_taichi_cpu_time": {f"{d}d": statistics.median(v) for d, v in cpu_ratios.items() if v}}
-    name = a.name or f"plastic_step_{'cuda' if a.device.startswith('cuda') else 'cpu'}"
-    print("wrote", write_json(name, out))
+    name = a.name or result_name("plastic_step", a)
+    print("wrote", write_json(name, out, out_dir(a, RESULTS, "plastic_step")))
     return 0
 
 

@@ -5,34 +5,38 @@ Times the same 110k-particle block (n_grid 48, one CPU thread by default) as
 that stays inside its yield surface (the return is compiled in but only the
 yield check runs), (d) Cam-Clay whose every particle yields every step, and
 reports device bytes per particle of each. Writes
-``benchmarks/results/leave_out_<device>.json``.
+``benchmarks/perf/results/leave_out_<device>.json``.
+
+Usage: ``python benchmarks/perf/leave_out.py [--n-grid 48] [--steps 30] [--threads 1] [--quick]``.
 """
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mpm_warp import CamClaySnow, Simulation
+from mpm_warp.studies.blocks import block_scenario
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser, result_name
+from mpm_warp.studies.timing import time_steps
 
-from common import block_scenario, environment, time_steps, write_json  # noqa: E402
-
-import mpm_warp  # noqa: E402
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--device", default="cpu")
+    ap = parser(__doc__, "n_grid 24 (14k particles), 5 steps")
     ap.add_argument("--n-grid", type=int, default=48)
     ap.add_argument("--steps", type=int, default=30)
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args(argv)
+    if a.quick:
+        a.n_grid, a.steps = 24, 5
     E, nu, rho = 1e5, 0.3, 1000.0
-    strong = mpm_warp.CamClaySnow(E, nu, rho, M=1.2, beta=0.3, xi=1.0, p0_ini=1e5)  # never reaches yield
+    strong = CamClaySnow(E, nu, rho, M=1.2, beta=0.3, xi=1.0, p0_ini=1e5)  # never reaches yield
     # no consolidation and no cohesion to speak of: gravity loading yields every particle every step
-    weak = mpm_warp.CamClaySnow(E, nu, rho, M=1.2, beta=0.0, xi=1e-3, p0_ini=0.0)
+    weak = CamClaySnow(E, nu, rho, M=1.2, beta=0.0, xi=1e-3, p0_ini=0.0)
     cases = {
         "elastic_no_walls": block_scenario(a.n_grid, boundary="none"),
         "elastic_box_walls": block_scenario(a.n_grid, boundary="slip"),
@@ -41,7 +45,7 @@ def main(argv=None) -> int:
     }
     rows = {}
     for name, sc in cases.items():
-        sim = mpm_warp.Simulation(sc, device=a.device, n_threads=a.threads)
+        sim = Simulation(sc, device=a.device, n_threads=a.threads)
         ts = time_steps(sim, a.steps)
         med = statistics.median(ts)
         N = sim.model.n_particles
@@ -59,7 +63,8 @@ def main(argv=None) -> int:
         r["time_vs_elastic_no_walls"] = r["s_per_step"] / base
     out = {"benchmark": "cost of walls and plasticity on the same block", "n_grid": a.n_grid, "threads": a.threads,
            "environment": environment(a.device), "cases": rows}
-    print("wrote", write_json(f"leave_out_{'cuda' if a.device.startswith('cuda') else 'cpu'}", out))
+    name = result_name("leave_out", a)
+    print("wrote", write_json(name, out, out_dir(a, RESULTS, "leave_out")))
     return 0
 
 

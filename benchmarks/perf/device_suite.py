@@ -3,13 +3,14 @@
 Usage::
 
     bash benchmarks/device_suite.sh [--device cuda:0] [--quick] [--out DIR] [--parts tests graph ...]
-    python benchmarks/device_suite.py ...            (the same)
+    python benchmarks/perf/device_suite.py ...            (the same)
+    bash benchmarks/device_suite.sh --plan [--quick]     (the parts, budgets and test modules, as JSON)
 
 Every part runs in its own interpreter under its own time budget (a part past
 its budget is killed with its process group and reported as ``timed_out`` with
 what it had written so far); the whole full-mode suite is budgeted below 8
 minutes. Results go to ``<out>/device_suite_<cuda|cpu>[_quick].json``
-(default ``benchmarks/results/``) with the device name, driver and CUDA
+(default ``benchmarks/perf/results/``; ``--quick``: a temporary folder) with the device name, driver and CUDA
 versions, Warp and Taichi versions, the date, the load average, and the
 seconds each part took beside its budget.
 
@@ -26,7 +27,7 @@ the CPU in seconds, as ``tests/test_device_suite.py`` does in CI):
     from the same state: bit-for-bit equality (``graph_deterministic``, Warp's
     run-to-run deterministic atomics; on the CPU every run is deterministic and
     a stand-in replays the captured step batches) or the observables within
-    ``plastic_block.AGREEMENT`` (production atomics), and the seconds per step
+    ``mpm_warp.studies.plastic_block.AGREEMENT`` (production atomics), and the seconds per step
     of both.
 ``memory``
     Device bytes per particle of the particle state and of the grid, elastic
@@ -52,9 +53,10 @@ import tempfile
 import time
 import xml.etree.ElementTree as ET
 
+# mpm_warp is imported inside the parts: the graph_deterministic part sets Warp's deterministic atomics first
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
+RESULTS = os.path.join(HERE, "results")
+ROOT = os.path.dirname(os.path.dirname(HERE))     # the repository: its tests/ run in the tests part
 
 #: Seconds each part may take: (full, quick). The full budgets sum to 450 s (< 8 min with start-up).
 BUDGETS = {"tests": (120, 60), "graph": (25, 40), "graph_deterministic": (25, 40), "memory": (15, 30),
@@ -132,14 +134,15 @@ def part_graph(device: str, quick: bool, deadline: float, out_dir: str, determin
 
     if deterministic and _is_cuda(device):
         wp.config.deterministic = wp.DeterministicMode.RUN_TO_RUN  # before any kernel module exists
-    import plastic_block as pb
-    import warp_block
+
+    from mpm_warp.studies import plastic_block as pb
+    from mpm_warp.studies.blocks import block_simulation
 
     n_grid = 24 if quick else 64
     steps = 6 if quick else 200
     results = {}
     for use_graph in (False, True):
-        sim = warp_block.block_simulation(3, "plastic", n_grid, device, n_threads=1)
+        sim = block_simulation(3, "plastic", n_grid, device, n_threads=1)
         sim.stepper.use_graph = use_graph
         sim.stepper.graph_batch = 4 if quick else 20
         st = sim.stepper
@@ -227,7 +230,8 @@ class _graph_stand_in:
 def part_memory(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
     """Bytes per particle of the particle state and of the grid, elastic and Cam-Clay, 3D and 2D."""
     import warp as wp
-    import warp_block
+
+    from mpm_warp.studies.blocks import block_simulation
 
     rows = []
     wp.init()
@@ -236,7 +240,7 @@ def part_memory(device: str, quick: bool, deadline: float, out_dir: str) -> dict
         n_grid = (24 if quick else 128) if dim == 3 else (24 if quick else 1448)
         wp.synchronize_device(dev)
         used0 = wp.get_mempool_used_mem_current(dev) if dev.is_cuda and wp.is_mempool_enabled(dev) else None
-        sim = warp_block.block_simulation(dim, material, n_grid, device, n_threads=1)
+        sim = block_simulation(dim, material, n_grid, device, n_threads=1)
         N = sim.model.n_particles
         st = sim.stepper
         row = {"dim": dim, "material": material, "n_grid": n_grid, "n_particles": N,
@@ -309,7 +313,7 @@ def _run_group(cmd, timeout: float, env=None, cwd=None) -> tuple[int | None, str
 
 def run_suite(device: str, quick: bool, out_dir: str, parts=PARTS) -> dict:
     """Run the parts, each in its own interpreter under its budget; write and return the suite's JSON."""
-    from common import environment, write_json
+    from mpm_warp.studies.environment import environment, write_json
 
     out = {"suite": "mpm_warp device suite", "mode": "quick" if quick else "full", "environment": environment(device),
            "budget_s": {p: BUDGETS[p][1 if quick else 0] for p in parts}, "parts": {}}
@@ -345,6 +349,15 @@ def run_suite(device: str, quick: bool, out_dir: str, parts=PARTS) -> dict:
     return out
 
 
+def plan(quick: bool) -> dict:
+    """What a run of this mode does: its parts, their budgets (s) and the test modules of the ``tests`` part."""
+    mode = 1 if quick else 0
+    modules = list(QUICK_TEST_MODULES) if quick else list(TEST_MODULES) + list(BITWISE_TEST_MODULES)
+    return {"mode": "quick" if quick else "full", "parts": list(PARTS),
+            "budget_s": {p: BUDGETS[p][mode] for p in PARTS}, "budget_s_total": sum(b[mode] for b in BUDGETS.values()),
+            "test_modules": modules}
+
+
 def _default_device() -> str:
     import warp as wp
 
@@ -352,15 +365,25 @@ def _default_device() -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    # the options of mpm_warp.studies.protocol, spelled out here: importing mpm_warp before the graph_deterministic
+    # part sets Warp's deterministic atomics would create kernel modules with the default mode
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--device", default=None, help="Warp device (default cuda:0 when present, else cpu)")
-    ap.add_argument("--quick", action="store_true", help="tiny sizes, few steps: seconds per part (CI)")
-    ap.add_argument("--out", default=os.path.join(HERE, "results"), help="folder of the JSON results")
+    ap.add_argument("--quick", action="store_true",
+                    help="tiny sizes, few steps: seconds per part, on the CPU as in CI; writes to a temporary folder "
+                         "unless --out")
+    ap.add_argument("--out", default=None, metavar="DIR",
+                    help="folder of the JSON results (default benchmarks/perf/results; --quick: a temporary folder)")
     ap.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
+    ap.add_argument("--plan", action="store_true",
+                    help="print the parts, their budgets (s) and test modules of this mode as JSON, run nothing")
     ap.add_argument("--run-part", default=None, choices=PARTS, help=argparse.SUPPRESS)
     ap.add_argument("--part-result", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--deadline", type=float, default=None, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.plan:
+        print(json.dumps(plan(a.quick)))
+        return 0
     device = a.device or _default_device()
     if a.run_part:
         deadline = a.deadline or time.time() + BUDGETS[a.run_part][1 if a.quick else 0]
@@ -368,7 +391,9 @@ def main(argv=None) -> int:
         with open(a.part_result, "w") as fh:
             json.dump(res, fh, indent=1, default=float)
         return 0
-    out = run_suite(device, a.quick, a.out, a.parts)
+    from mpm_warp.studies.protocol import out_dir
+
+    out = run_suite(device, a.quick, out_dir(a, RESULTS, "device_suite"), a.parts)
     return 0 if all(p["status"] == "ok" for p in out["parts"].values()) else 1
 
 

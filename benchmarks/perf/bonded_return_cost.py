@@ -1,7 +1,8 @@
 """Cost of the bonded Cam-Clay return against camclay's, per point, for elastic and yielding trials.
 
-Usage: ``python benchmarks/bonded_return_cost.py [--device cpu|cuda] [--n 1000000] [--precision float32]``.
-Writes ``benchmarks/results/bonded_return_cost_<device>.json``. One kernel launch
+Usage: ``python benchmarks/perf/bonded_return_cost.py [--device cpu|cuda] [--n 1000000] [--precision float32]
+[--quick]``.
+Writes ``benchmarks/perf/results/bonded_return_cost_<device>.json``. One kernel launch
 returns ``n`` independent principal Hencky strains (no decomposition: the returns alone,
 ``bonded_camclay_return_strain`` and ``camclay_return_strain``), with
 the weak layer of the PST (E 1 MPa, nu 0.3, M 1.2, beta 0.3, xi 0.0041, p_bond
@@ -13,22 +14,21 @@ strain, 1e-4, in a random direction: the crack tip), ``yield_bond_gone``
 Each figure is the median of three launches after a warm-up launch (compiled).
 """
 
-import argparse
 import functools
 import os
 import statistics
-import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import numpy as np
+import warp as wp
 
-import numpy as np  # noqa: E402
-import warp as wp  # noqa: E402
-from common import environment, write_json  # noqa: E402
+from mpm_warp.kernels.bonded_camclay import bonded_camclay_return_strain_func
+from mpm_warp.kernels.camclay import camclay_return_strain_func, initial_log_jp
+from mpm_warp.kernels.types import vec3
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
 
-from mpm_warp.kernels.bonded_camclay import bonded_camclay_return_strain_func  # noqa: E402
-from mpm_warp.kernels.camclay import camclay_return_strain_func, initial_log_jp  # noqa: E402
-from mpm_warp.kernels.types import vec3  # noqa: E402
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 E, NU, M, BETA, XI, P_BOND, KAPPA_S = 1e6, 0.3, 1.2, 0.3, 0.0041261, 3058.3, 0.025374
 MU, LAM = E / (2 * (1 + NU)), E * NU / ((1 + NU) * (1 - 2 * NU))
@@ -92,11 +92,12 @@ def _time(kernel, n, inputs, device) -> list[float]:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--device", default="cpu")
+    ap = parser(__doc__, "1e4 points per set")
     ap.add_argument("--n", type=int, default=1_000_000)
     ap.add_argument("--precision", default="float32", choices=["float32", "float64"])
     a = ap.parse_args(argv)
+    if a.quick:
+        a.n = 10_000
     T, nt = (wp.float32, np.float32) if a.precision == "float32" else (wp.float64, np.float64)
     dev = wp.get_device(a.device)
     run_bonded, run_camclay = _kernels(T)
@@ -120,8 +121,9 @@ def main(argv=None) -> int:
         rows.append(row)
         print(f"{name:16s} yielded {yielded:5.2f} / {yielded_c:5.2f}: bonded {row['bonded_ns_per_point']:8.1f} ns, "
               f"camclay {row['camclay_ns_per_point']:8.1f} ns per point, ratio {row['ratio']:5.2f}", flush=True)
-    path = write_json(f"bonded_return_cost_{dev.alias.split(':')[0]}",
-                      {"environment": environment(a.device), "precision": a.precision, "rows": rows})
+    path = write_json(f"bonded_return_cost_{dev.alias.split(':')[0]}" + ("_quick" if a.quick else ""),
+                      {"environment": environment(a.device), "precision": a.precision, "rows": rows},
+                      out_dir(a, RESULTS, "bonded_return_cost"))
     print("wrote", path)
     return 0
 

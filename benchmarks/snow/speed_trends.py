@@ -17,56 +17,52 @@ collapsing layer with the run's own measured collapse height, ``c ~ E^(1/4) h_f^
 log-log slopes ``d ln c / d ln E`` and ``d ln c / d ln h_f`` (the measured collapse on the axis) are
 reported against Heierli's +1/4 and -1/4.
 
-Cases run as Dask tasks (:func:`common.dask_map`, one worker process per core). Writes
-``benchmarks/results/snow_speed_trends.json`` and ``.png``.
+Cases run as Dask tasks (:func:`mpm_warp.studies.fanout.dask_map`, one worker process per core). Writes
+``benchmarks/snow/results/snow_speed_trends.json`` and ``.png``.
 
 Usage::
 
-    nohup .venv/bin/python benchmarks/snow_speed_trends.py > trends.log 2>&1 &
+    nohup .venv/bin/python benchmarks/snow/speed_trends.py > trends.log 2>&1 &
+    .venv/bin/python benchmarks/snow/speed_trends.py --quick      # three runs, to a temporary folder
 """
 
 from __future__ import annotations
 
-import argparse
 import json
-import math
 import os
 import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mpm_warp.studies.convergence import loglog_slope
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.fanout import dask_map
+from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.snow import FIELD_SPEED, ladder_pst
 
-from common import RESULTS, dask_map, environment, write_json  # noqa: E402
-from snow_wf_sweep import COLUMN, FIELD_SPEED  # noqa: E402
-
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+#: the ladder PST (mpm_warp.studies.snow) at dx 10 mm, 6 cells across its 6 cm layer
+COLUMN = ladder_pst(0.01)
 CUT = 0.7                                   # m: the saw's stop, beyond every case's critical cut
 SLAB_E = (1.25e6, 2.5e6, 5.0e6, 7.5e6, 1.0e7)  # Pa
 H_C_FACTORS = (0.5, 1.0, 2.0)               # of the WEAC fit of the layer's thickness
 
 
-def one_case(param: str, value: float, device: str) -> dict:
+def one_case(param: str, value: float, device: str, column: list = COLUMN, cut: float = CUT) -> dict:
     """One PST with ``param`` (``"slab.E"`` or ``"weak_layer.h_c"``) set to ``value``: runs in a Dask worker."""
     import mpm_warp as mw
     from mpm_warp.scenes.pst import cut_run
 
-    sc = mw.load_scenario("pst_flat", COLUMN + [f"scene.{param}={value!r}"])
+    sc = mw.load_scenario("pst_flat", column + [f"scene.{param}={value!r}"])
     t0 = time.perf_counter()
-    r = cut_run(sc, CUT, run_distance=sc.scene.length, free_run=0.5, device=device, n_threads=1)
+    r = cut_run(sc, cut, run_distance=sc.scene.length, free_run=0.5, device=device, n_threads=1)
     s = r["summary"]
     return {"param": param, "value": value, "propagated": r["propagated"], "front": r["front"],
             "speed": s.get("damage_speed_mean"), "speed_over": s.get("damage_speed_mean_over"),
             "collapse_height": s.get("collapse_height"), "touchdown": s.get("touchdown"),
             "heierli_speed_run": s.get("heierli_speed_run"), "h_c_calibrated": sc.scene.calibrated().h_c,
             "slab_E": sc.scene.slab.E, "steps": r["steps"], "wall_s": time.perf_counter() - t0}
-
-
-def slope(x, y) -> float:
-    """Least-squares slope of ``ln y`` against ``ln x`` (nan if fewer than two finite points)."""
-    x, y = np.asarray(x, float), np.asarray(y, float)
-    ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
-    return float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0]) if ok.sum() >= 2 else math.nan
 
 
 def figure(data: dict, path: str) -> None:
@@ -76,6 +72,7 @@ def figure(data: dict, path: str) -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    cut = data.get("cut", CUT)
     for ax, (key, xlabel, xscale) in zip(axes, (("slab.E", "slab Young's modulus E [MPa]", 1e-6),
                                                  ("weak_layer.h_c", "weak layer's collapse height h_c [mm]", 1e3)),
                                           strict=True):
@@ -83,14 +80,14 @@ def figure(data: dict, path: str) -> None:
         x = np.array([r["value"] if key == "slab.E" else r["h_c_calibrated"] for r in rows]) * xscale
         ran = np.array([bool(r["propagated"]) for r in rows])
         ax.plot(x[ran], [r["speed"] for r, k in zip(rows, ran, strict=True) if k], "o-", color="C3",
-                label=f"damage front, mean {CUT:g}-{rows[0]['speed_over'][1]:.1f} m "
+                label=f"damage front, mean {cut:g}-{rows[0]['speed_over'][1]:.1f} m "
                       f"(slope {data['trends'][key]['slope_speed']:+.2f})")
         ax.plot(x[ran], [r["heierli_speed_run"] for r, k in zip(rows, ran, strict=True) if k], "s--", color="C2",
                 label=f"Heierli, run's collapse (slope {data['trends'][key]['slope_heierli']:+.2f})"
                       + ("" if key == "slab.E" else "\n(slopes against the measured collapse)"))
         for r, xv, k in zip(rows, x, ran, strict=True):
             if not k:
-                ax.annotate(f"no crack from a {CUT:g} m cut\n(front stopped at {r['front']:.2f} m)",
+                ax.annotate(f"no crack from a {cut:g} m cut\n(front stopped at {r['front']:.2f} m)",
                             (xv, FIELD_SPEED[0]), xytext=(5, 20), textcoords="offset points", fontsize=8,
                             arrowprops=dict(arrowstyle="->"))
         ax.axhspan(*FIELD_SPEED, color="0.88", label="field 20-30 m/s")
@@ -116,38 +113,43 @@ def figure(data: dict, path: str) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = parser(__doc__, "a smoke run: a 1.2 m column (too short for the trends) cut to 0.4 m; slab E 2.5 and "
+                         "5 MPa, h_c 2 x the fit")
     ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
-    ap.add_argument("--device", default="cpu")
-    ap.add_argument("--figure-only", action="store_true", help="redraw the figure from the JSON")
+    ap.add_argument("--figure-only", action="store_true", help="redraw the figure from the JSON in --out (or results)")
     a = ap.parse_args(argv)
+    name = "snow_speed_trends" + ("_quick" if a.quick else "")
     if a.figure_only:
-        with open(os.path.join(RESULTS, "snow_speed_trends.json")) as fh:
-            figure(json.load(fh), os.path.join(RESULTS, "snow_speed_trends.png"))
+        folder = a.out or RESULTS
+        with open(os.path.join(folder, name + ".json")) as fh:
+            figure(json.load(fh), os.path.join(folder, name + ".png"))
         return 0
+    slab_e, h_c_factors = ((2.5e6, 5.0e6), (1.0, 2.0)) if a.quick else (SLAB_E, H_C_FACTORS)
     from mpm_warp.scenes.references import weac_collapse_height
 
     h_fit = weac_collapse_height(0.06)
-    cases = [("slab.E", e) for e in SLAB_E] + [("weak_layer.h_c", f * h_fit) for f in H_C_FACTORS if f != 1.0]
+    cases = [("slab.E", e) for e in slab_e] + [("weak_layer.h_c", f * h_fit) for f in h_c_factors if f != 1.0]
     t0 = time.perf_counter()
-    rows = dask_map(one_case, [(p, v, a.device) for p, v in cases], a.workers, a.scheduler)
+    column, cut = (COLUMN + ["scene.length=1.2"], 0.4) if a.quick else (COLUMN, CUT)
+    rows = dask_map(one_case, [(p, v, a.device, column, cut) for p, v in cases], a.workers, a.scheduler)
     centre = next(r for r in rows if r["param"] == "slab.E" and r["value"] == 5.0e6)
     trends = {}
     for key, members in (("slab.E", [r for r in rows if r["param"] == "slab.E"]),
                          ("weak_layer.h_c", sorted([r for r in rows if r["param"] == "weak_layer.h_c"] + [centre],
                                                    key=lambda r: r["collapse_height"]))):
         x = [r["value"] if key == "slab.E" else r["collapse_height"] for r in members]
-        trends[key] = {"cases": members, "slope_speed": slope(x, [r["speed"] for r in members]),
-                       "slope_heierli": slope(x, [r["heierli_speed_run"] for r in members]),
+        trends[key] = {"cases": members, "slope_speed": loglog_slope(x, [r["speed"] for r in members]),
+                       "slope_heierli": loglog_slope(x, [r["heierli_speed_run"] for r in members]),
                        "heierli_exponent": 0.25 if key == "slab.E" else -0.25,
                        "arrested": [r["value"] for r in members if not r["propagated"]],
                        "monotone": bool(np.all(np.diff([r["speed"] for r in members]) *
                                                (1 if key == "slab.E" else -1) > 0))}
-    data = {"trends": trends, "column": COLUMN, "cut": CUT, "h_c_fit": h_fit, "wall_s": time.perf_counter() - t0,
+    data = {"trends": trends, "column": column, "cut": cut, "h_c_fit": h_fit, "wall_s": time.perf_counter() - t0,
             "environment": environment(a.device)}
-    write_json("snow_speed_trends", data)
-    figure(data, os.path.join(RESULTS, "snow_speed_trends.png"))
+    folder = out_dir(a, RESULTS, "speed_trends")
+    print("wrote", write_json(name, data, folder))
+    figure(data, os.path.join(folder, name + ".png"))
     for key, t in trends.items():
         print(f"{key}: speed slope {t['slope_speed']:+.3f} (Heierli with the runs' collapse {t['slope_heierli']:+.3f},"
               f" closed form {t['heierli_exponent']:+.2f}); monotone {t['monotone']}")

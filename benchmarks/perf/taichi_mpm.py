@@ -17,43 +17,24 @@ particles since the total ``F_zz`` is 1): the return sees the three principal
 stretches ``(s_0, s_1, F_zz)`` and the in-plane stress uses ``tr eps`` over all
 three.
 
-The Cam-Clay return is the same algorithm as mpm_warp's (docs/model.md §4): the
-point of the yield ellipse closest to the trial ``(p, q)`` in the energy metric
-``dp^2/K + dq^2/(3 mu)``, found in scaled coordinates by Eberly's
-parametrisation with Newton steps from the left end of the root bracket
-interleaved with bisection (the same stopping rule: ``0 <= f <= 4 eps`` or a
-bracket below ``4 eps (1 + s)``, at most 100 iterations), then
-``log_Jp += tr eps_tr - tr eps_new`` and ``p0 = K sinh(xi max(-log_Jp, 0))``
-(explicit hardening).
+The Cam-Clay return (``taichi_camclay``) is the same algorithm as mpm_warp's (docs/model.md §4).
 """
 
 from __future__ import annotations
 
-import math
-import os
-import sys
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+from taichi_camclay import S_FLOOR, camclay_return_func
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mpm_warp.studies import plastic_block as pb
+from mpm_warp.studies.blocks import ELASTIC_DT, ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, GRAVITY_Y
 
-import plastic_block as pb  # noqa: E402
-
-#: Elastic block (the elastic throughput scene): Young's modulus (Pa), Poisson ratio, density (kg/m^3), step (s).
-ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, ELASTIC_DT = 1.0e5, 0.3, 1000.0, 1.0e-4
-#: Gravity along y (m/s^2).
-GRAVITY_Y = -9.81
 #: Width (in cells) of the slip boundary layer, Taichi style.
 BOUND = 3
 #: Absolute grid-mass threshold (kg) below which a node is treated as empty.
 MASS_EPS = 1.0e-12
-#: Singular-value floor before ln (as mpm_warp's).
-S_FLOOR = 1.0e-6
-#: Newton/bisection iterations at most, and the float32 tolerance, of the ellipse root.
-MAX_ROOT_ITERATIONS = 100
-ROOT_EPS = 4.0 * 2.0**-23
 
 MODES = ("elastic", "plastic", "plastic_track", "no_return")
 
@@ -108,15 +89,6 @@ def build(ti: Any, n_grid: int, dim: int, material: str) -> SimpleNamespace:
     bound = BOUND
     mass_eps = MASS_EPS
     s_floor = S_FLOOR
-    # Cam-Clay constants (docs/model.md §2-3)
-    M_csl, beta, xi = pb.M_CSL, pb.BETA, pb.XI
-    p0_floor = pb.P0_FLOOR_RATIO * K
-    x_cap = math.asinh(-3.0 * math.log(S_FLOOR))
-    rho_m = math.sqrt(3.0 * mu / K)  # q = a rho_m v in the scaled coordinates
-    c_axis = M_csl / (math.sqrt(1.0 + 2.0 * beta) * rho_m)
-    sqrt6 = math.sqrt(6.0)
-    root_eps = ROOT_EPS
-    max_it = MAX_ROOT_ITERATIONS
 
     x = ti.Vector.field(dim, dtype=f32, shape=n_particles)
     v = ti.Vector.field(dim, dtype=f32, shape=n_particles)
@@ -129,100 +101,7 @@ def build(ti: Any, n_grid: int, dim: int, material: str) -> SimpleNamespace:
     yielded = ti.field(dtype=ti.u8, shape=n_particles) if plastic else None
     F_zz = ti.field(dtype=f32, shape=n_particles) if plastic and dim == 2 else None
 
-    @ti.func
-    def ellipse_root_f(s, n0, r0, z1):
-        a = n0 / (s + r0)
-        b = z1 / (s + 1.0)
-        return ti.Vector([a * a + b * b - 1.0, -2.0 * (a * a / (s + r0) + b * b / (s + 1.0))])
-
-    @ti.func
-    def ellipse_closest(e0, e1, y0, y1):
-        """Closest point of (x0/e0)^2 + (x1/e1)^2 = 1 to (y0, y1) >= 0, outside, e0 >= e1 > 0 (Eberly)."""
-        res = ti.Vector([y0, y1])
-        if y1 <= 0.0:
-            res = ti.Vector([e0, 0.0])
-        elif y0 <= 0.0:
-            res = ti.Vector([0.0, e1])
-        else:
-            z0 = y0 / e0
-            z1 = y1 / e1
-            if z0 * z0 + z1 * z1 > 1.0:
-                r0 = (e0 / e1) * (e0 / e1)
-                n0 = r0 * z0
-                m = ti.max(n0, z1)
-                lo = ti.max(0.0, ti.max(z1 - 1.0, n0 - r0))
-                hi = ti.max(lo, m * ti.sqrt((n0 / m) * (n0 / m) + (z1 / m) * (z1 / m)) - 1.0)
-                fd = ellipse_root_f(lo, n0, r0, z1)
-                f_lo = fd[0]
-                df_lo = fd[1]
-                it = 0
-                while it < max_it and f_lo > root_eps and hi - lo > root_eps * (1.0 + lo):
-                    it += 1
-                    s = lo
-                    if df_lo < 0.0:
-                        s = ti.min(ti.max(lo - f_lo / df_lo, lo), hi)
-                    fd = ellipse_root_f(s, n0, r0, z1)
-                    if fd[0] >= 0.0:
-                        lo = s
-                        f_lo = fd[0]
-                        df_lo = fd[1]
-                    else:
-                        hi = s
-                    if f_lo > root_eps and hi - lo > root_eps * (1.0 + lo):
-                        s = 0.5 * (lo + hi)
-                        fd = ellipse_root_f(s, n0, r0, z1)
-                        if fd[0] >= 0.0:
-                            lo = s
-                            f_lo = fd[0]
-                            df_lo = fd[1]
-                        else:
-                            hi = s
-                res = ti.Vector([r0 * y0 / (lo + r0), y1 / (lo + 1.0)])
-        return res
-
-    @ti.func
-    def camclay_return(s, ljp):
-        """Principal stretches s (3) and log_Jp -> (s_new, log_Jp_new, yielded) (docs/model.md §4)."""
-        eps = ti.Vector([ti.log(ti.max(s[0], s_floor)), ti.log(ti.max(s[1], s_floor)),
-                         ti.log(ti.max(s[2], s_floor))])
-        tr = eps[0] + eps[1] + eps[2]
-        dev = eps - tr / 3.0
-        p_tr = -K * tr
-        q_tr = sqrt6 * mu * dev.norm()
-        h = ti.min(xi * ti.max(-ljp, 0.0), x_cap)
-        p0 = ti.max(K * 0.5 * (ti.exp(h) - ti.exp(-h)), p0_floor)  # K sinh(h): Taichi has no sinh
-        y = (1.0 + 2.0 * beta) * q_tr * q_tr + M_csl * M_csl * (p_tr + beta * p0) * (p_tr - p0)
-        s_new = s
-        ljp_new = ljp
-        hit = 0
-        if y > 0.0:
-            hit = 1
-            a = 0.5 * p0 * (1.0 + beta)
-            pc = 0.5 * p0 * (1.0 - beta)
-            du = p_tr - pc
-            u = ti.abs(du) / a
-            w = q_tr / (a * rho_m)
-            xu = 0.0
-            xv = 0.0
-            if ti.static(c_axis <= 1.0):
-                r = ellipse_closest(1.0, c_axis, u, w)
-                xu = r[0]
-                xv = r[1]
-            else:
-                r = ellipse_closest(c_axis, 1.0, w, u)
-                xu = r[1]
-                xv = r[0]
-            p_new = p0 - a * (1.0 - xu)
-            if du < 0.0:
-                p_new = -beta * p0 + a * (1.0 - xu)
-            q_new = a * rho_m * xv
-            scale = 0.0
-            if q_tr > 0.0:
-                scale = ti.min(q_new / q_tr, 1.0)
-            m_new = -p_new / (3.0 * K)
-            s_new = ti.exp(dev * scale + m_new)
-            ljp_new = ljp + tr - 3.0 * m_new
-        return s_new, ljp_new, hit
+    camclay_return = camclay_return_func(ti, mu, K)
 
     def make_affine(do_return: bool, track: bool):
         @ti.func
@@ -384,26 +263,3 @@ def build(ti: Any, n_grid: int, dim: int, material: str) -> SimpleNamespace:
     return SimpleNamespace(fields=fields, n_particles=n_particles, dt=dt, reset=reset, snapshot=snapshot,
                            restore=restore, substep=substep, plastic=plastic, dim=dim)
 
-
-def block_positions(n_grid: int, dim: int = 3) -> np.ndarray:
-    """Initial particle lattice of the benchmark block.
-
-    ``(n_grid**dim, dim)`` float32 positions, ``x = 0.25 + (i + 0.5) dx / 2``
-    per axis (2 particles per cell and axis), computed in float64 and rounded
-    once; C order over the axes, the same lattice as mpm_warp's seeding.
-    """
-    if n_grid <= 0 or n_grid % 2:
-        raise ValueError(f"n_grid must be a positive even integer, got {n_grid}")
-    dx = 1.0 / n_grid
-    axis = 0.25 + (np.arange(n_grid, dtype=np.float64) + 0.5) * (0.5 * dx)
-    grids = np.meshgrid(*([axis] * dim), indexing="ij")
-    return np.stack([g.ravel() for g in grids], axis=1).astype(np.float32)
-
-
-def initial_state(n_grid: int, dim: int, material: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(x0, v0, C0)`` float32 arrays of the block: at rest (elastic) or struck (plastic_block)."""
-    x0 = block_positions(n_grid, dim)
-    if material == "plastic":
-        return (x0, pb.initial_velocity(x0).astype(np.float32),
-                pb.initial_velocity_gradient(x0).astype(np.float32))
-    return x0, np.zeros_like(x0), np.zeros((len(x0), dim, dim), dtype=np.float32)
