@@ -34,6 +34,7 @@ import time
 
 import mpm_warp as mw
 from mpm_warp.scenes.pst import critical_cut
+from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import FIELD_CUT, ladder_pst
@@ -95,7 +96,7 @@ def ladder_rows() -> dict:
             if lv.get("bisection", {}).get("narrowed_from"):
                 label = label[:-1] + ", narrowed)"
             out[label] = {"trials": lv["trials"], "lo": lo, "hi": hi,
-                          "gaume": sc.scene.references(sc.scene.calibrated()).get("critical_cut_gaume")}
+                          "gaume": sc.scene.references(stored_calibration(sc)).get("critical_cut_gaume")}
     return out
 
 
@@ -142,7 +143,7 @@ def run_case(name: str, data: dict, device: str) -> dict:
     t0 = time.perf_counter()
     res = critical_cut(sc, device=device, log=lambda s: print(f"{name}: {s}", flush=True), **bracket)
     wall = time.perf_counter() - t0
-    refs = sc.scene.references(sc.scene.calibrated())
+    refs = sc.scene.references(stored_calibration(sc))
     out = {"scene": scene, "overrides": overrides, "bracket": bracket, "value": res.value, "bracketed": res.bracketed,
            "note": res.note, "lo": res.lo,
            "hi": res.hi, "trials": res.trials, "runaway_cut_of_base": res.runaway_cut, "wall_s": wall,

@@ -28,6 +28,7 @@ import time
 import numpy as np
 
 import mpm_warp as mw
+from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import FIELD_SPEED, ladder_pst
@@ -133,7 +134,7 @@ def main(argv=None) -> int:
     folder = out_dir(a, RESULTS, "pst")
     os.makedirs(a.h5dir, exist_ok=True)
     h5 = os.path.join(a.h5dir, f"snow_{name}.h5")
-    print(sc.scene.calibrated().describe(), flush=True)
+    print(stored_calibration(sc).describe(), flush=True)
     t0 = time.perf_counter()
     if a.resume:
         rr = mw.resume(h5, device=a.device)
@@ -147,7 +148,7 @@ def main(argv=None) -> int:
            "environment": environment(a.device), "wall_s": wall,
            "resumed": bool(a.resume), "steps": rr.steps, "particles": rr.n_particles,
            "particle_steps_per_s": rr.particle_steps_per_s, "h5": h5,
-           "weak_layer": sc.scene.calibrated().to_dict(),
+           "weak_layer": stored_calibration(sc).to_dict(),
            "result": rr.scene_result, "times": list(mon.times),
            "series": {k: list(mon.series[k]) for k in keep}}
     r = rr.scene_result

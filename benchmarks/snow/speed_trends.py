@@ -35,6 +35,7 @@ import time
 
 import numpy as np
 
+from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.convergence import loglog_slope
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.fanout import dask_map
@@ -61,7 +62,7 @@ def one_case(param: str, value: float, device: str, column: list = COLUMN, cut: 
     return {"param": param, "value": value, "propagated": r["propagated"], "front": r["front"],
             "speed": s.get("damage_speed_mean"), "speed_over": s.get("damage_speed_mean_over"),
             "collapse_height": s.get("collapse_height"), "touchdown": s.get("touchdown"),
-            "heierli_speed_run": s.get("heierli_speed_run"), "h_c_calibrated": sc.scene.calibrated().h_c,
+            "heierli_speed_run": s.get("heierli_speed_run"), "h_c_calibrated": stored_calibration(sc).h_c,
             "slab_E": sc.scene.slab.E, "steps": r["steps"], "wall_s": time.perf_counter() - t0}
 
 

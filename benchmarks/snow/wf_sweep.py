@@ -23,6 +23,7 @@ import os
 import sys
 import time
 
+from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.fanout import dask_map
 from mpm_warp.studies.protocol import out_dir, parser
@@ -44,7 +45,7 @@ def one_case(w_f: float, lo: float, hi: float, tol: float, device: str, column: 
     res = critical_cut(sc, lo, hi, tol=tol, base_run_distance=sc.scene.length, device=device, n_threads=1,
                        log=lines.append)
     b = res.base
-    cal = sc.scene.calibrated()
+    cal = stored_calibration(sc)
     return {"w_f": w_f, "delta_s": cal.delta_s, "kappa_s": cal.kappa_s, "debond_energy": cal.debond_energy,
             "critical_cut": res.value, "bracketed": res.bracketed, "note": res.note, "lo": res.lo, "hi": res.hi,
             "trials": res.trials, "runaway_cut_of_base": res.runaway_cut,
