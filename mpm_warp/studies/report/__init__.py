@@ -1,0 +1,94 @@
+"""The results document, ``docs/results.md``, and the README's headline numbers, generated from the benchmarks' JSON.
+
+Run ``python -m mpm_warp.studies.report`` after a benchmark has written new results (``--check`` only says
+whether the committed files are current; ``tests/test_results_current.py`` checks it in CI). Every number
+in the document is formatted from the committed JSON under ``benchmarks/<group>/results/``: none is typed
+into the text. Pure JSON and NumPy: no simulation runs.
+
+**Adding a study.** Each result file has one section: a function ``render(data, ctx) -> list[str]`` of the
+file's JSON that returns the Markdown lines of its tables and findings, registered with its title, its file
+(relative to ``benchmarks/``), the command that reproduces it and its figure::
+
+    @section("snow", "My study", "snow/results/my_study.json", "python benchmarks/snow/my_study.py",
+             figure="snow/results/my_study.png", question="What does my study ask?")
+    def render_my_study(data, ctx):
+        rows = [[c["name"], fx(c["speed"], 1)] for c in data["cases"]]
+        return table(["case", "speed (m/s)"], rows) + ["", env_note(data)]
+
+in the module of its part (:mod:`.perf`, :mod:`.convergence`, :mod:`.snow_runs`, :mod:`.snow_studies`;
+sections appear in the order they are registered). Format every number with :mod:`.fmt` and put the
+environment note (:func:`.fmt.env_note`) under the table. A study whose JSON is not committed yet is
+registered with :func:`.core.pending` (its section says "not measured yet" until the file appears); a file
+that does not exist is always skipped with that line, so a section can be written before its first run.
+Then run the command and commit ``docs/results.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from . import convergence, perf, snow_runs, snow_studies  # noqa: F401  (registration, in document order)
+from .core import DOC, SECTIONS, Context, document, pending, section
+from .readme import headlines, with_block
+
+__all__ = ["SECTIONS", "Context", "section", "pending", "default_root", "results_markdown", "readme_text", "main"]
+
+
+def default_root() -> str:
+    """The repository this package runs from (an editable install's checkout)."""
+    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+
+
+def results_markdown(root: str | None = None) -> str:
+    """The text of ``docs/results.md`` from the results under ``<root>/benchmarks/``."""
+    return document(Context(root or default_root()))
+
+
+def readme_text(root: str | None = None) -> str | None:
+    """``README.md`` with its headline block regenerated; None when it has no markers (or no README)."""
+    root = root or default_root()
+    path = os.path.join(root, "README.md")
+    if not os.path.isfile(path):
+        return None
+    with open(path) as fh:
+        return with_block(fh.read(), headlines(Context(root)))
+
+
+def _write(path: str, text: str) -> None:
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path + ".tmp", "w") as fh:
+        fh.write(text)
+    os.replace(path + ".tmp", path)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m mpm_warp.studies.report", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--root", default=None, help="the repository (default: the checkout this package runs from)")
+    ap.add_argument("--check", action="store_true", help="write nothing; exit 1 if a generated file is out of date")
+    a = ap.parse_args(argv)
+    root = a.root or default_root()
+    doc = os.path.join(root, DOC)
+    targets = [(doc, results_markdown(root))]
+    readme = readme_text(root)
+    if readme is not None:
+        targets.append((os.path.join(root, "README.md"), readme))
+    stale = []
+    for path, text in targets:
+        old = open(path).read() if os.path.isfile(path) else None
+        if old != text:
+            stale.append(path)
+            if not a.check:
+                _write(path, text)
+    for path in stale:
+        print(("out of date: " if a.check else "wrote ") + os.path.relpath(path, root))
+    if not stale:
+        print("current: " + ", ".join(os.path.relpath(p, root) for p, _ in targets))
+    if readme is None:
+        print("README.md has no results markers: left alone")
+    return 1 if (a.check and stale) else 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,7 @@
+"""``python -m mpm_warp.studies.report``: write ``docs/results.md`` and the README's headline block."""
+
+import sys
+
+from . import main
+
+sys.exit(main())

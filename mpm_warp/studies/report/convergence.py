@@ -1,0 +1,203 @@
+"""Sections of the convergence results: the reference problems' error against run time, the snow ladders
+(PST and shear test, level by level), and the weak layer's mesh study."""
+
+from __future__ import annotations
+
+from .core import section
+from .fmt import DASH, bracket, count, env_note, finite, fx, pct, ratio_range, secs, spct, table
+
+# ----------------------------------------------------------------------------- reference problems
+
+
+def _time_to(t: dict | None) -> str:
+    """A ``time_to`` record: ``'1,352 s (interpolated)'`` or ``'not reached (1.3 % at the finest)'``."""
+    if not t:
+        return DASH
+    if finite(t.get("wall_time_s")):
+        return f"{secs(t['wall_time_s'])}: {t.get('status', '')}"
+    if finite(t.get("error_at_finest_compared")):
+        return f"{t.get('status', 'not reached')} ({pct(t['error_at_finest_compared'])} at the finest)"
+    return t.get("status", DASH)
+
+
+@section("convergence", "Error against run time: the reference problems", "convergence/results/error_vs_runtime.json",
+         lambda d: f"python benchmarks/convergence/error_vs_runtime.py --threads {d['environment'].get('n_threads', 1)}"
+                   f" --repeats {d['settings'].get('repeats')}",
+         figure="convergence/results/error_vs_runtime.png",
+         question="How does the error of each reference problem fall with dx and the CFL factor, against run time?")
+def render_error_vs_runtime(data: dict, ctx) -> list[str]:
+    st = data.get("settings") or {}
+    target = st.get("target_error")
+    rows = []
+    for name, p in data["problems"].items():
+        s = p["summary"]
+        t = s.get("time_to_1pct") or {}
+        rows.append([name, p["precision"], fx(s.get("observed_order_dx"), 2), fx(s.get("observed_order_dx_finest3"), 2),
+                     fx(s.get("error_time_slope"), 2), _time_to(t),
+                     fx(t.get("dx"), 4, unit="m") if finite(t.get("dx")) else DASH,
+                     fx(s.get("observed_order_cfl_of_change"), 2)])
+    out = table(["problem", "precision", "order in dx", "order, finest three", "slope of log error against log time",
+                 f"stepping time to {pct(target, 0)} error", "at dx", "order in the CFL factor"], rows)
+    out += ["", env_note(data), "",
+            f"dx halving at CFL {fx(st.get('cfl_dx_ladder'), 1)}, {st.get('particles_per_cell_per_axis')} particles "
+            f"per cell and axis; the CFL ladder ({', '.join(fx(c, 1) for c in st.get('cfl_ladder', []))}) at one dx. "
+            f"Wall time: stepping only, median of {st.get('repeats')} runs, one thread. The references:", ""]
+    out += [f"- `{name}`: {p['reference']}." for name, p in data["problems"].items()]
+    for name, p in data["problems"].items():
+        out += ["", f"`{name}`, every level:", ""]
+        lv = [("dx", r) for r in p["dx_ladder"]] + [("CFL", r) for r in p["dt_ladder"]]
+        out += table(["ladder", "dx (m)", "CFL", "mean dt (s)", "steps", "particles", "error", "wall (s)",
+                      "M particle-steps/s"],
+                     [[k, f"{r['dx']:.5g}", fx(r["cfl"], 1), f"{r['dt_mean_s']:.3g}", count(r["steps"]),
+                       count(r["n_particles"]), spct(r["signed_error"], 3), f"{r['wall_time_s']:.3g}",
+                       fx(r["particle_steps_per_s"], 2, 1e-6)] for k, r in lv])
+    return out
+
+
+# ----------------------------------------------------------------------------- the snow ladders
+#: quantity -> (label, scale, unit, decimals), per ladder.
+QUANTITIES = {
+    "pst": {"critical_cut": ("critical cut", 1.0, "m", 3), "speed": ("crack speed", 1.0, "m/s", 1),
+            "touchdown": ("touchdown behind the front", 1.0, "m", 3),
+            "collapse_height": ("collapse height (outside the far end zone)", 1e3, "mm", 2)},
+    "shear": {"peak": ("peak shear stress", 1.0, "Pa", 1),
+              "delta_s": ("softening slip delta_s (the interior's bond)", 1e3, "mm", 3),
+              "delta_s_whole_layer": ("delta_s, the whole layer's bond", 1e3, "mm", 3),
+              "collapse": ("collapse 1 - J_P", 1.0, "", 3)},
+}
+
+
+def ladder_levels(data: dict, name: str, precision: str = "float32") -> list[dict]:
+    """The ladder's levels of one precision, coarsest first."""
+    return sorted((r for r in data["ladders"][name] if r["precision"] == precision), key=lambda r: r["level"])
+
+
+def _value(rec: dict, key: str, spec) -> str:
+    label, scale, unit, nd = spec
+    if key == "critical_cut" and finite(rec.get(key)):
+        lo, hi = rec["critical_cut_bracket"]
+        return bracket(rec[key], lo, hi, nd)
+    return fx(rec.get(key), nd, scale, unit)
+
+
+def changes(values) -> list[float]:
+    """Relative change from each level to the next (where both are finite)."""
+    return [b / a - 1.0 for a, b in zip(values, values[1:], strict=False) if finite(a) and finite(b) and a != 0]
+
+
+def _changes(values) -> str:
+    ch = changes(values)
+    return ", ".join(spct(c) for c in ch) if ch else DASH
+
+
+def _cells(rec: dict) -> str:
+    return f"{rec['cells_across_layer']:g} cells"
+
+
+def render_ladder(data: dict, name: str) -> list[str]:
+    """The tables of one ladder: its levels, the quantities per level, their errors and times to 5 % and 1 %."""
+    levels = ladder_levels(data, name)
+    summ = data["summary"][name]
+    heads = [_cells(r) for r in levels]
+    out = table(["level", "dx (m)", "particles", "steps", "wall time", "M particle-steps/s"],
+                [[_cells(r), f"{r['dx']:g}", count(r["n_particles"]), count(r["steps"]), secs(r["wall_time_s"]),
+                  fx(r["particle_steps_per_s"], 1, 1e-6)] for r in levels])
+    out += [""]
+    rows, errs = [], []
+    targets = next(iter(summ.values()))["time_to"].keys()
+    for key, spec in QUANTITIES[name].items():
+        s = summ.get(key)
+        if s is None:
+            continue
+        use_rich = s.get("reference_used_for_time_to") == "richardson"
+        rich = fx(s.get("richardson"), spec[3], spec[1], spec[2])
+        rows.append([spec[0], *[_value(r, key, spec) for r in levels], _changes(s["values"]),
+                     fx(s.get("observed_order"), 2), rich])
+        e = s["error_vs_richardson"] if use_rich else s["error_vs_finest"]
+        errs.append([spec[0], *[pct(x) for x in e], "extrapolated " + rich if use_rich else "the finest level",
+                     *[_time_to(s["time_to"].get(k)) for k in targets]])
+    out += table(["quantity", *heads, "changes per halving", "observed order", "extrapolated"], rows)
+    growing = [QUANTITIES[name][k][0] for k, s in summ.items() if k in QUANTITIES[name]
+               and len(changes(s["values"])) >= 2
+               and all(abs(b) > abs(a) for a, b in zip(changes(s["values"]), changes(s["values"])[1:], strict=False))]
+    if growing:
+        out += ["", "The change grows with every halving (no observed order, not converging at these levels): "
+                + "; ".join(growing) + "."]
+    out += ["", "Errors against the reference (the Richardson extrapolation where the three finest levels change "
+            "monotonically with an order in the range `mpm_warp.studies.convergence.richardson` accepts, else the "
+            "finest level), and the wall time to each error on this CPU:", ""]
+    out += table(["quantity", *heads, "reference", *[f"time to {k.replace('%', ' %')}" for k in targets]], errs)
+    notes = [f"{_cells(r)}: {r['note']}" for r in levels if r.get("note")]
+    if notes:
+        out += ["", "Notes of the levels: " + "; ".join(notes) + "."]
+    out += _precision(data, name, levels)
+    return out
+
+
+def _precision(data: dict, name: str, levels: list[dict]) -> list[str]:
+    """float32 against float64 at the level run in both."""
+    out = []
+    for r64 in ladder_levels(data, name, "float64"):
+        r32 = next((r for r in levels if r["level"] == r64["level"]), None)
+        if r32 is None:
+            continue
+        parts = []
+        for key, spec in QUANTITIES[name].items():
+            a, b = r32.get(key), r64.get(key)
+            if key == "critical_cut" and finite(a):
+                same = list(r32["critical_cut_bracket"]) == list(r64["critical_cut_bracket"])
+                parts.append(f"{spec[0]}: {'the same bracket' if same else 'different brackets'}")
+            elif finite(a) and finite(b) and b != 0:
+                parts.append(f"{spec[0]} {abs(a / b - 1):.1e} apart")
+        out += ["", f"float32 against float64 at {_cells(r64)} (relative): " + "; ".join(parts) + "."]
+    return out
+
+
+@section("convergence", "Error against run time: the snow ladders", "convergence/results/error_vs_runtime_snow.json",
+         "python benchmarks/convergence/error_vs_runtime_snow.py",
+         figure="convergence/results/error_vs_runtime_snow.png",
+         question="How fine must a PST and a shear test be for a given error, and how long does that take? "
+                  "(dx halving, 2D, float32)")
+def render_snow_ladders(data: dict, ctx) -> list[str]:
+    out = []
+    if "shear" in data["ladders"]:
+        out += ["**Shear test** (SI Note 2's case, the whole push), per number of cells across the layer:", ""]
+        out += render_ladder(data, "shear") + [""]
+    if "pst" in data["ladders"]:
+        lv = ladder_levels(data, "pst")
+        over = lv[0].get("speed_over") if lv else None
+        out += ["**Flat PST** (the ladder PST: `pst_flat`'s slab, layer and saw on a shorter column, "
+                "`mpm_warp.studies.snow.LADDER_PST`); each level one bisection of the critical cut plus the base run"
+                + (f", whose crack speed is the mean over {fx(over[0], 1)}-{fx(over[1], 1)} m" if over else "") + ":",
+                ""]
+        out += render_ladder(data, "pst") + [""]
+    envs = [data] + ([{"environment": data["environment_pst"]}] if data.get("environment_pst") else [])
+    out += [env_note(*envs, verb="last written") + " The levels ran on several dates and commits (each level's "
+            "`git_commit` in the JSON); wall times are upper bounds on the shared CPU."]
+    return out
+
+
+# ----------------------------------------------------------------------------- the mesh study
+@section("convergence", "The weak layer's collapse under a slab: mesh study", "convergence/results/mesh_study.json",
+         "python benchmarks/convergence/mesh_study.py", figure="convergence/results/mesh_study.png",
+         question="How does the weak layer's collapse depend on dx, xi and the load (Gaume et al. 2018, SI Note 3)?")
+def render_mesh_study(data: dict, ctx) -> list[str]:
+    cells = sorted({c for s in data["summary"] for c in s["cells"]})
+    rows = []
+    for s in data["summary"]:
+        err = dict(zip(s["cells"], s["error"], strict=True))
+        rows.append([fx(s["xi"], 2), fx(s["rho_slab"], 0), s["precision"], fx(s["W_mean"], 0),
+                     fx(s["collapse_theory"], 4), *[spct(err.get(c)) for c in cells],
+                     pct(s.get("spread_8_cells_up")), fx(s.get("observed_order_4_cells_up"), 2)])
+    out = [f"Plain Cam-Clay layer of {fx(data['set_up']['D_wl'], 3, 1e2)} cm under an elastic slab in a laterally "
+           f"confined column, gravity ramped; the layer's mean 1 - J_P against the closed form `{data['closed_form']}`"
+           ".", ""]
+    out += table(["xi", "slab rho (kg/m^3)", "precision", "load W (Pa)", "closed form 1 - J_P",
+                  *[f"error at {c} cells" for c in cells], "spread from 8 cells on", "order from 4 cells on"], rows)
+    out += ["", env_note(data), "", "The error of the float64 cases, by cells across the layer:", ""]
+    f64 = [s for s in data["summary"] if s["precision"] == "float64"]
+    for c in cells:
+        e = [dict(zip(s["cells"], s["error"], strict=True)).get(c) for s in f64]
+        if any(finite(x) for x in e):
+            out.append(f"- {c} cells: {ratio_range([100 * x for x in e], 1)} %.")
+    return out

@@ -1,0 +1,94 @@
+"""The README's few headline numbers, from the same JSON as the results document, and the README block they fill.
+
+The block sits between :data:`BEGIN` and :data:`END` in ``README.md``; without both markers the README is
+left alone.
+"""
+
+from __future__ import annotations
+
+from ..snow import FIELD_SPEED
+from .core import Context, slug
+from .fmt import bracket, finite, fx, ratio_range, spct
+
+__all__ = ["BEGIN", "END", "headlines", "with_block"]
+
+BEGIN = "<!-- results:begin -->"
+END = "<!-- results:end -->"
+
+
+def _link(title: str) -> str:
+    return f"docs/results.md#{slug(title)}"
+
+
+def _throughput(ctx: Context, source: str, dim: int, title: str) -> str | None:
+    data = ctx.load(source)
+    if data is None:
+        return None
+    rows = [r for r in data["rows"] if r["engine"] == "mpm_warp" and r["dim"] == dim and r["threads"] == 1]
+    parts = [f"{ratio_range([r.get('ratio_vs_taichi_cpu_time') for r in rows if r['material'] == m], 2)}x ({m})"
+             for m in sorted({r["material"] for r in rows})]
+    if not parts:
+        return None
+    return (f"- **CPU throughput beside Taichi, {dim}D:** {' and '.join(parts)} Taichi's particle-steps per CPU "
+            f"second, one thread ([{title}]({_link(title)})).")
+
+
+def _pst_speed(ctx: Context) -> str | None:
+    data = ctx.load("snow/results/snow_pst_flat.json")
+    if data is None:
+        return None
+    r = data["result"]
+    v = r.get("damage_speed_mean")
+    a, b = r.get("damage_speed_mean_over") or (None, None)
+    if not finite(v):
+        return None
+    where = "inside" if FIELD_SPEED[0] <= v <= FIELD_SPEED[1] else "outside"
+    return (f"- **PST crack speed:** `pst_flat`'s crack runs at {fx(v, 1)} m/s on average from {fx(a, 1)} to "
+            f"{fx(b, 1)} m, {where} the field's {FIELD_SPEED[0]:g}-{FIELD_SPEED[1]:g} m/s "
+            f"([PST: `pst_flat`]({_link('PST: `pst_flat`')})).")
+
+
+def _critical_cut(ctx: Context) -> str | None:
+    lad = ctx.load("convergence/results/error_vs_runtime_snow.json")
+    weac = ctx.load("snow/results/weac_static_pst.json")
+    if lad is None or weac is None:
+        return None
+    levels = [r for r in lad["ladders"].get("pst", []) if r["precision"] == "float32" and r.get("bracketed")]
+    w = (weac.get("ladder") or {}).get("flat", {}).get("critical_cut")
+    if not levels or not finite(w):
+        return None
+    f = max(levels, key=lambda r: r["cells_across_layer"])
+    lo, hi = f["critical_cut_bracket"]
+    title = "Error against run time: the snow ladders"
+    return (f"- **Critical cut:** {bracket(f['critical_cut'], lo, hi)} on the flat ladder PST at "
+            f"{f['cells_across_layer']:g} cells across the layer, against weac's static {fx(w, 3)} m "
+            f"({spct(f['critical_cut'] / w - 1)}) ([{title}]({_link(title)})).")
+
+
+def _shear(ctx: Context) -> str | None:
+    data = ctx.load("snow/results/snow_shear_test.json")
+    if data is None or not data.get("runs"):
+        return None
+    res = [r["result"] for r in data["runs"]]
+    tau = res[0].get("tau_p_calibrated")
+    cells = " / ".join(str(r["cells"]) for r in data["runs"])
+    return (f"- **Shear test:** peak {' / '.join(fx(x['peak_shear_stress'], 1) for x in res)} Pa at {cells} cells "
+            f"against the given tau_p {fx(tau, 0)} Pa "
+            f"({' / '.join(spct(x['peak_shear_stress'] / tau - 1) for x in res)}) "
+            f"([Shear test]({_link('Shear test')})).")
+
+
+def headlines(ctx: Context) -> list[str]:
+    """The README's headline bullets (a bullet whose results are not committed is left out)."""
+    out = [_throughput(ctx, "perf/results/throughput_cpu.json", 3, "Throughput beside Taichi, 3D"),
+           _throughput(ctx, "perf/results/throughput_2d_cpu.json", 2, "Throughput beside Taichi, 2D"),
+           _pst_speed(ctx), _critical_cut(ctx), _shear(ctx)]
+    return [b for b in out if b]
+
+
+def with_block(readme: str, bullets: list[str]) -> str | None:
+    """``readme`` with the text between :data:`BEGIN` and :data:`END` replaced by ``bullets``; None without markers."""
+    i, j = readme.find(BEGIN), readme.find(END)
+    if i < 0 or j < i:
+        return None
+    return readme[:i + len(BEGIN)] + "\n" + "\n".join(bullets) + "\n" + readme[j:]

@@ -1,0 +1,181 @@
+"""Sections of the snow runs: the full PSTs (``pst_flat``, ``pst_slope``), the critical-cut bisections and the
+shear test, each beside its field or analytical reference."""
+
+from __future__ import annotations
+
+import math
+
+from ...scenes.pst.analysis import SPEED_LIMIT_DISTANCE, SPEED_WINDOW
+from ..snow import FIELD_CUT, FIELD_SPEED, LADDER_PST
+from .core import section
+from .fmt import DASH, bracket, count, env_note, finite, fx, secs, spct, table
+
+
+def _pst_command(data: dict) -> str:
+    sets = "".join(f" --set {o}" for o in data.get("overrides") or [])
+    return f"python benchmarks/snow/pst.py {data['scenario']}{sets} --h5dir /tmp/snow"
+
+
+def speed_profile_summary(res: dict, prefix: str) -> dict:
+    """The local speed profile of one front: its first window, its largest value within the reported distance,
+    and the first window faster than the slab's shear wave (``None`` where there is none)."""
+    prof = res.get(f"{prefix}_speed_profile") or {"s": [], "speed": []}
+    cut = res.get("cut_length", 0.0)
+    pts = [(s, v) for s, v in zip(prof["s"], prof["speed"], strict=True)
+           if finite(v) and s <= cut + SPEED_LIMIT_DISTANCE]
+    out = {"first": pts[0] if pts else None, "max": max(pts, key=lambda p: p[1]) if pts else None, "supershear": None}
+    cs = res.get("shear_wave_speed")
+    if finite(cs):
+        out["supershear"] = next((p for p in pts if p[1] > cs), None)
+    return out
+
+
+def _profile_text(res: dict, prefix: str) -> str:
+    p = speed_profile_summary(res, prefix)
+    if p["max"] is None:
+        return DASH
+    (s0, v0), (s1, v1) = p["first"], p["max"]
+    cs = res.get("shear_wave_speed")
+    return (f"{v0:.1f} m/s at {s0:.2f} m -> largest {v1:.1f} m/s at {s1:.2f} m"
+            + (f" ({v1 / cs:.2f} c_s)" if finite(cs) else ""))
+
+
+def render_pst(data: dict, ctx) -> list[str]:
+    r, wl = data["result"], data["weak_layer"]
+    given = wl.get("given") or {}
+    a, b = r.get("damage_speed_mean_over") or (math.nan, math.nan)
+    sup = speed_profile_summary(r, "damage")["supershear"]
+    lead = r.get("max_damage_lead")
+    rows = [
+        ["particles; steps; wall time", f"{count(data['particles'])}; {count(data['steps'])}; {secs(data['wall_s'])}"
+         + (" (resumed once)" if data.get("resumed") else ""), ""],
+        [f"crack speed (damage front), mean over {fx(a, 1)}-{fx(b, 1)} m", fx(r["damage_speed_mean"], 1, unit="m/s"),
+         f"field {FIELD_SPEED[0]:g}-{FIELD_SPEED[1]:g} m/s; Heierli {fx(r.get('heierli_speed_run'), 1)} m/s "
+         f"(the run's collapse) / {fx(r.get('heierli_speed'), 1)} m/s (calibrated h_c)"],
+        ["deflection front, the same mean", fx(r["deflection_speed_mean"], 1, unit="m/s"),
+         f"ratio to the damage front {fx(r.get('front_agreement'), 3)}"],
+        [f"local speed of the damage front ({fx(SPEED_WINDOW, 2)} m windows, within {fx(SPEED_LIMIT_DISTANCE, 1)} m "
+         "of the cut)", _profile_text(r, "damage"),
+         f"c_s {fx(r.get('shear_wave_speed'), 1)} m/s, c_R {fx(r.get('rayleigh_speed'), 1)} m/s"],
+        ["local speed of the deflection front", _profile_text(r, "deflection"), ""],
+        ["first window faster than c_s", f"{sup[1]:.1f} m/s at {sup[0]:.2f} m" if sup else "none", ""],
+        ["saw position when the crack leaves it", fx(r.get("runaway_cut"), 3, unit="m"),
+         f"Gaume et al. 2017 critical cut {fx(r.get('critical_cut_gaume'), 3)} m"],
+        ["touchdown behind the front", fx(r.get("touchdown"), 3, unit="m"),
+         f"Heierli {fx(r.get('heierli_touchdown_run'), 3)} m (the run's collapse) / "
+         f"{fx(r.get('heierli_touchdown'), 3)} m (calibrated h_c)"],
+        ["collapse height behind the front (the monitor's, last frame)", fx(r.get("collapse_height"), 2, 1e3, "mm"),
+         f"calibrated h_c {fx(r.get('collapse_height_calibrated'), 2, 1e3)} mm"],
+        ["damage ahead of the contiguous front", "none" if lead == 0 else
+         f"{fx(lead, 2)} m, at {fx(r.get('max_damage_lead_at'), 2)} m", ""],
+        ["damage front's reach", f"{fx(r.get('damage_front_final'), 2)} m of {fx(r.get('column_length'), 1)} m"
+         + (" (into the far end zone)" if r.get("ran_to_end") else ""), ""],
+    ]
+    out = [f"{data.get('description', '')}: the layer given as tau_p {fx(given.get('tau_p'), 0)} Pa, "
+           f"w_f {fx(given.get('w_f'), 2)} J/m^2 under a {fx(given.get('slab_thickness'), 2)} m slab of "
+           f"{fx(given.get('slab_density'), 0)} kg/m^3, calibrated to p_bond {fx(wl.get('p_bond'), 0)} Pa, "
+           f"kappa_s {fx(wl.get('kappa_s'), 1)} J/m^3, xi {fx(wl.get('xi'), 4)} (delta_s "
+           f"{fx(wl.get('delta_s'), 2, 1e3)} mm, h_c {fx(wl.get('h_c'), 2, 1e3)} mm).", ""]
+    out += table(["quantity", f"`{data['name']}`", "reference"], rows, ["l", "l", "l"])
+    out += ["", env_note(data)]
+    if data.get("resume_note"):
+        out += ["", f"Resumed: {data['resume_note']}."]
+    return out
+
+
+for _name in ("pst_flat", "pst_slope"):
+    section("snow", f"PST: `{_name}`", f"snow/results/snow_{_name}.json", _pst_command,
+            figure=f"snow/results/snow_{_name}.png",
+            question="What do a full PST's fronts, speed profiles, touchdown and collapse look like? (Figure: the "
+                     "fronts and the saw against time, the local speeds, the slab base's deflection.)")(render_pst)
+
+
+# ----------------------------------------------------------------------------- critical cut
+def _weac_key(case: dict) -> str | None:
+    """The weac ladder case of a critical-cut case on the ladder PST (by its slope and cut end), else None."""
+    if not all(o in (case.get("overrides") or []) for o in LADDER_PST):
+        return None
+    th = case.get("slope_angle", 0.0)
+    return "flat" if th == 0 else f"{'upslope' if th > 0 else 'downslope'}_{abs(th):g}"
+
+
+def _ladder_reference(ctx, dx: float):
+    lad = ctx.load("convergence/results/error_vs_runtime_snow.json")
+    if lad is None:
+        return None
+    return next((r for r in lad["ladders"].get("pst", []) if r["precision"] == "float32"
+                 and math.isclose(r["dx"], dx) and finite(r.get("critical_cut"))), None)
+
+
+@section("snow", "Critical cut", "snow/results/snow_critical_cut.json",
+         lambda d: "python benchmarks/snow/critical_cut.py " + " ".join(d["cases"]),
+         figure="snow/results/snow_critical_cut.png",
+         question="What is the critical cut length, flat, on a slope, at half saw speed? (Bisection on the saw's "
+                  "stop position, trial runs forked from one base run.)")
+def render_critical_cut(data: dict, ctx) -> list[str]:
+    weac = (ctx.load("snow/results/weac_static_pst.json") or {}).get("ladder") or {}
+    rows, overrides, vals = [], [], []
+    for name, c in data["cases"].items():
+        ref = _ladder_reference(ctx, c["dx"]) if _weac_key(c) else None
+        wk = _weac_key(c)
+        w = (weac.get(wk) or {}).get("critical_cut") if wk else None
+        v = c.get("value")
+        if c.get("bracketed"):
+            vals.append(v)
+        rows.append([f"`{name}`", f"`{c['scene']}`", fx(c["dx"] * 1e3, 1), fx(c.get("slope_angle"), 0),
+                     fx(c.get("saw_speed"), 2), bracket(v, c["lo"], c["hi"]) if c.get("bracketed") else
+                     (c.get("note") or DASH), len(c.get("trials") or []),
+                     spct(v / ref["critical_cut"] - 1) if ref and finite(v) else DASH,
+                     f"{fx(w, 3)} m ({spct(v / w - 1)})" if finite(w) and finite(v) else DASH,
+                     fx(c.get("gaume"), 3), fx(c.get("runaway_cut_of_base"), 3), fx(c.get("base_speed_mean"), 1),
+                     secs(c.get("wall_s"))])
+        overrides.append(f"- `{name}`: `{c['scene']}` with " + " ".join(f"`{o}`" for o in c.get("overrides") or []))
+    out = table(["case", "scene", "dx (mm)", "slope (deg)", "saw (m/s)", "critical cut (m)", "trials",
+                 "against the flat ladder at that dx", "weac (static)", "Gaume 2017 (m)",
+                 "base run: saw when the crack left it (m)", "base run: speed (m/s)", "wall time"], rows)
+    out += ["", env_note(*data["cases"].values()), "", "The cases' columns (scenario overrides):", ""] + overrides
+    if vals:
+        inside = all(FIELD_CUT[0] <= v <= FIELD_CUT[1] for v in vals)
+        out += ["", f"Every bracketed cut {'lies' if inside else 'does not lie'} within the field's "
+                f"{FIELD_CUT[0]:g}-{FIELD_CUT[1]:g} m ({fx(min(vals), 3)}-{fx(max(vals), 3)} m). The slope angle is "
+                "positive when the saw cuts from the upslope end; weac's column is the ladder's, static, with "
+                "its energy criterion at the same fracture energy."]
+    return out
+
+
+# ----------------------------------------------------------------------------- shear test
+@section("snow", "Shear test", "snow/results/snow_shear_test.json",
+         lambda d: "python benchmarks/snow/shear_test.py --cells " + " ".join(str(r["cells"]) for r in d["runs"]),
+         figure="snow/results/snow_shear_test.png",
+         question="What peak, softening slip and collapse does the shear test of Gaume et al. 2018 (SI Note 2) give?")
+def render_shear_test(data: dict, ctx) -> list[str]:
+    runs = data["runs"]
+    res = [r["result"] for r in runs]
+    tau_p = res[0].get("tau_p_calibrated")
+
+    def row(label, key, nd, scale=1.0, unit="", ref=""):
+        return [label, *[fx(x.get(key), nd, scale, unit) for x in res], ref]
+
+    rows = [["particles; steps; wall time", *[f"{count(r['particles'])}; {count(r['steps'])}; {secs(r['wall_s'])}"
+                                              for r in runs], ""],
+            ["peak shear stress", *[f"{fx(x['peak_shear_stress'], 1)} Pa ({spct(x['peak_shear_stress'] / tau_p - 1)})"
+                                    for x in res], f"given tau_p {fx(tau_p, 0)} Pa"],
+            row("softening slip, the interior's bond (peak to bond loss)", "softening_displacement", 3, 1e3, "mm",
+                f"given {fx(data.get('si_softening_slip'), 1, 1e3)} mm (SI Note 2)"),
+            row("softening slip, the whole layer's bond", "softening_displacement_whole_layer", 3, 1e3, "mm"),
+            row("softening slip of the push plate", "plate_softening_displacement", 3, 1e3, "mm"),
+            row("residual shear stress", "residual_shear_stress", 0, 1.0, "Pa"),
+            row("collapse 1 - J_P at the end of the push", "collapse_fraction", 3,
+                ref=f"about {fx(data.get('si_collapse'), 1)} (SI Note 2); oedometric law at sigma_n "
+                    f"{fx(res[0].get('collapse_fraction_law'), 3)}"),
+            row("critical-state law at the final pressure", "collapse_fraction_critical_state", 3),
+            row("final pressure p", "p_final", 0, 1.0, "Pa"),
+            ["bond lost", *["yes" if x.get("bond_lost") else "no" for x in res], ""]]
+    out = table(["quantity", *[f"{r['cells']} cells (dx {fx(r['dx'] * 1e3, 2)} mm)" for r in runs], "reference"],
+                rows, ["l"] * (len(runs) + 2))
+    ch = data.get("change_4_to_8_cells") or {}
+    out += ["", env_note(data)]
+    if ch:
+        out += ["", f"From {runs[0]['cells']} to {runs[-1]['cells']} cells: peak {spct(ch.get('peak_shear_stress'))}, "
+                f"softening slip {spct(ch.get('softening_displacement'))}."]
+    return out
