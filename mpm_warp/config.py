@@ -21,7 +21,8 @@ from .materials import Elastic
 from .walls import WALL_KINDS, WallKind
 
 __all__ = ["Block", "Domain", "TimeControl", "Output", "Scenario", "SceneParams", "OUTPUT_FIELDS", "PRECISIONS",
-           "BOUNDARIES", "Precision", "Boundary", "ON_INVERSION", "MAX_STEPS", "MAX_MACH"]
+           "BOUNDARIES", "Precision", "Boundary", "ON_INVERSION", "MAX_STEPS", "MAX_MACH", "STABLE_DT", "first_step",
+           "check_end_time"]
 
 Precision = Literal["float32", "float64"]
 PRECISIONS: tuple[str, ...] = get_args(Precision)
@@ -36,6 +37,9 @@ ON_INVERSION: tuple[str, ...] = get_args(OnInversion)
 MAX_STEPS = 1.0e8
 #: fastest initial speed, in multiples of the fastest P-wave speed of the materials (snow: 70-300 m/s)
 MAX_MACH = 100.0
+#: the stability limit of a fixed step, in dx / c_p: measured 1.10 stable, 1.12 blowing up (docs/robustness.md);
+#: a larger ``time.dt`` is refused unless ``time.allow_unstable_dt``
+STABLE_DT = 1.11
 #: particle fields the output may hold: name -> (per-particle shape, unit, description); "dim" is the scene's dimension
 OUTPUT_FIELDS = {
     "x": (("dim",), "m", "position"),
@@ -136,6 +140,9 @@ class TimeControl:
         Fixed step (s); 0 selects the automatic step.
     dt_max : float
         Upper bound of the automatic step (s); 0 means none.
+    allow_unstable_dt : bool
+        Accept a fixed ``dt`` above the stability limit :data:`STABLE_DT` ``dx / c_p`` (stability studies:
+        the health check then stops the run); False (default) refuses it before anything runs.
     gravity : (dim,) float or None
         Gravitational acceleration (m/s^2); a slope is a rotated gravity. None: 9.81 m/s^2 along -y.
     gravity_ramp : float
@@ -152,6 +159,7 @@ class TimeControl:
     cfl: float = 0.4
     dt: float = 0.0
     dt_max: float = 0.0
+    allow_unstable_dt: bool = False
     gravity: tuple | None = None
     gravity_ramp: float = 0.0
     damping: float = 0.0
@@ -302,6 +310,7 @@ def _time(t: TimeControl, dim: int) -> TimeControl:
         cfl=finite_number("time.cfl", t.cfl, lo=0.0, hi=1.0, lo_open=True),
         dt=finite_number("time.dt", t.dt, lo=0.0),
         dt_max=finite_number("time.dt_max", t.dt_max, lo=0.0),
+        allow_unstable_dt=_flag("time.allow_unstable_dt", t.allow_unstable_dt),
         gravity=vector("time.gravity", (0.0, -9.81, 0.0)[:dim] if t.gravity is None else t.gravity, dim),
         gravity_ramp=finite_number("time.gravity_ramp", t.gravity_ramp, lo=0.0),
         damping=finite_number("time.damping", t.damping, lo=0.0),
@@ -333,25 +342,26 @@ def _block(b: Block, i: int, mats: dict, dom: Domain) -> Block:
     return Block(b.material, blo, bhi, vel, ppc, b.name or f"block{i}")
 
 
-def _step_budget(tc: TimeControl, dx: float, mats: dict, blocks) -> None:
-    """Refuse speeds, moduli and densities that would make a run take more than :data:`MAX_STEPS` steps.
+def _flag(field: str, value) -> bool:
+    if not isinstance(value, bool):
+        raise InvalidArgument(field, value, "true or false")
+    return value
 
-    The first step is ``dt = cfl dx / (c_p + |v|)`` (``time.dt`` if fixed, capped by ``time.dt_max``)
-    with ``c_p`` the fastest P-wave speed and ``|v|`` the fastest constant initial speed (a Python
-    velocity function is not evaluated here); an initial speed above :data:`MAX_MACH` ``c_p`` is
-    refused on its own.
+
+def first_step(tc: TimeControl, dx: float, mats: dict, blocks) -> tuple[float, str, Any, str, float, str]:
+    """The first step of a run, for the budget and stability checks (validated time, materials and blocks).
+
+    ``dt = cfl dx / (c_p + |v|)`` (``time.dt`` if fixed, capped by ``time.dt_max``) with ``c_p`` the
+    fastest P-wave speed of the materials in use and ``|v|`` the fastest constant initial speed (a
+    Python velocity function is not evaluated here).
+
+    Returns
+    -------
+    (dt [s], the field that sets it, its value, how it is set (words), c_p [m/s], the material's name)
     """
     name, fastest = max(((k, m) for k, m in mats.items() if any(b.material == k for b in blocks)),
                         key=lambda km: km[1].p_wave_speed)
     c_p = fastest.p_wave_speed
-    for i, b in enumerate(blocks):
-        if callable(b.velocity):
-            continue
-        speed = math.sqrt(sum(c * c for c in b.velocity))
-        if speed > MAX_MACH * c_p:
-            raise InvalidArgument(f"blocks[{i}].velocity", b.velocity, (
-                f"a speed at most {MAX_MACH:g} times the fastest P-wave speed, {MAX_MACH * c_p:.3g} m/s "
-                f"(c_p = {c_p:.3g} m/s of materials.{name}); |v| = {speed:.3g} m/s is Mach {speed / c_p:.3g}"))
     vmax = max((math.sqrt(sum(c * c for c in b.velocity)) for b in blocks if not callable(b.velocity)), default=0.0)
     if tc.dt > 0:
         dt, field, value, why = tc.dt, "time.dt", tc.dt, "the fixed step"
@@ -362,7 +372,40 @@ def _step_budget(tc: TimeControl, dx: float, mats: dict, blocks) -> None:
                f"{c_p:.3g} m/s of materials.{name}")
     if tc.dt_max > 0 and tc.dt_max < dt:
         dt, field, value, why = tc.dt_max, "time.dt_max", tc.dt_max, "the step cap time.dt_max"
+    return dt, field, value, why, c_p, name
+
+
+def _step_budget(tc: TimeControl, dx: float, mats: dict, blocks) -> None:
+    """Refuse speeds, moduli and densities that would make a run take more than :data:`MAX_STEPS` steps,
+    an initial speed above :data:`MAX_MACH` ``c_p``, and a fixed step above the stability limit
+    :data:`STABLE_DT` ``dx / c_p`` (unless ``time.allow_unstable_dt``)."""
+    dt, field, value, why, c_p, name = first_step(tc, dx, mats, blocks)
+    for i, b in enumerate(blocks):
+        if callable(b.velocity):
+            continue
+        speed = math.sqrt(sum(c * c for c in b.velocity))
+        if speed > MAX_MACH * c_p:
+            raise InvalidArgument(f"blocks[{i}].velocity", b.velocity, (
+                f"a speed at most {MAX_MACH:g} times the fastest P-wave speed, {MAX_MACH * c_p:.3g} m/s "
+                f"(c_p = {c_p:.3g} m/s of materials.{name}); |v| = {speed:.3g} m/s is Mach {speed / c_p:.3g}"))
+    limit = STABLE_DT * dx / c_p
+    if tc.dt > limit and not tc.allow_unstable_dt:
+        raise InvalidArgument("time.dt", tc.dt, (
+            f"a fixed step at most the stability limit {STABLE_DT:g} dx / c_p = {limit:.3g} s (dx = {dx:g} m, c_p = "
+            f"{c_p:.3g} m/s of materials.{name}); it is {tc.dt / limit:.3g} times that (0 = the automatic step, "
+            "or time.allow_unstable_dt = true for a stability study)"))
     steps = tc.end / dt
     if steps > MAX_STEPS:
         raise InvalidArgument(field, value, f"values giving at most {MAX_STEPS:.0e} steps to time.end = {tc.end:g} s: "
                               f"{why} makes dt = {dt:.3g} s and {steps:.3g} steps")
+
+
+def check_end_time(scenario: Scenario, value, field: str = "end_time") -> float:
+    """An end time [s] given beside a validated ``scenario`` (``Simulation.run``, ``resume``), checked as
+    ``time.end`` is: a finite number > 0 whose run takes at most :data:`MAX_STEPS` steps."""
+    end = finite_number(field, value, lo=0.0, lo_open=True)
+    dt, _, _, why, _, _ = first_step(scenario.time, scenario.domain.dx, scenario.materials, scenario.blocks)
+    if end / dt > MAX_STEPS:
+        raise InvalidArgument(field, value, f"a time giving at most {MAX_STEPS:.0e} steps: {why} makes dt = "
+                              f"{dt:.3g} s and {end / dt:.3g} steps")
+    return end

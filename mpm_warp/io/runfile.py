@@ -124,6 +124,9 @@ class RunWriter:
                  attrs: dict | None = None, compression: str = "gzip", overwrite: bool = True,
                  append: bool = False, keep_frames: int | None = None, verify: bool = True):
         self.path, self._f, self._verify = os.fspath(path), None, verify
+        for name, value in (("overwrite", overwrite), ("append", append), ("verify", verify)):
+            if not isinstance(value, bool):
+                raise InvalidArgument(name, value, "True or False")
         if not isinstance(n_particles, (int, np.integer)) or n_particles < 1:
             raise InvalidArgument("n_particles", n_particles, "an integer >= 1")
         if compression not in COMPRESSION:
