@@ -24,13 +24,23 @@ from .errors import MPMError, SimulationBlowUp
 __all__ = ["main"]
 
 
+class Interrupted(KeyboardInterrupt):
+    """A signal that ends the command at once; ``signum`` (the exit status is 128 + signum)."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
 class StopRequest:
     """SIGINT/SIGTERM handler: stop the run with a checkpoint, never an unbounded wait.
 
     Python may swallow a KeyboardInterrupt raised inside a callback, so the CLI catches the
-    signals itself. A first signal lets the current frame finish when it is due within
-    :attr:`far_s` seconds of wall time (judged from the last frame's duration); otherwise, and
-    on a second signal, the simulation stops after its current batch of steps
+    signals itself. Before the simulation exists (reading the scenario, building the scene) a
+    signal ends the command at once (:class:`Interrupted`: nothing to checkpoint yet). Once it
+    runs, a first signal lets the current frame finish when it is due within :attr:`far_s`
+    seconds of wall time (judged from the last frame's duration); otherwise, and on a second
+    signal, the simulation stops after its current batch of steps
     (:meth:`mpm_warp.Simulation.request_stop`) with a checkpoint that resumes exactly. A third
     signal aborts at once (complete frames are kept).
     """
@@ -73,8 +83,10 @@ class StopRequest:
 
     def _handle(self, signum, frame):
         self.signals += 1
+        if self.sim is None:                   # not stepping yet: nothing to finish or checkpoint
+            raise Interrupted(signum)
         if self.signals >= 3:
-            raise KeyboardInterrupt
+            raise Interrupted(signum)
         self.requested = True
         if self.signals == 1 and self.frame_due_in() <= self.far_s:
             sys.stderr.write("\nmpm-warp: stop requested; finishing the current frame (signal again to stop "
@@ -346,7 +358,7 @@ def build_parser() -> argparse.ArgumentParser:
     rs = sub.add_parser("resume", help="continue a run from its last checkpoint")
     rs.add_argument("run", help="the run's HDF5 file (its checkpoint RUN.ckpt.h5 must sit beside it)")
     rs.add_argument("--device", default=None)
-    rs.add_argument("--end", type=float, default=None, help="new end time (s), not before the checkpoint's")
+    rs.add_argument("--end", type=float, default=None, help="new end time (s), after the run file's last frame")
     rs.add_argument("--max-memory", default=None, metavar="SIZE", help="as for run")
     rs.add_argument("--quiet", action="store_true", help="no progress bar")
     rs.set_defaults(func=cmd_resume)
@@ -382,9 +394,11 @@ def main(argv=None) -> int:
     except OSError as e:                 # a file system refusing something the checks could not foresee
         print(f"mpm-warp: error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("mpm-warp: interrupted; complete frames are kept in the output file", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as e:
+        signum = getattr(e, "signum", signal.SIGINT)
+        print(f"mpm-warp: interrupted ({signal.Signals(signum).name}); complete frames are kept in the output file",
+              file=sys.stderr)
+        return 128 + signum
 
 
 if __name__ == "__main__":  # pragma: no cover

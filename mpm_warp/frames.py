@@ -8,6 +8,8 @@ with ``append``) keeps every series as an uninterrupted run would.
 
 from __future__ import annotations
 
+import errno
+import os
 import secrets
 
 import numpy as np
@@ -17,7 +19,8 @@ from .config import OUTPUT_FIELDS
 from .errors import InvalidArgument
 from .result import versions
 
-__all__ = ["open_writer", "particle_field", "frame_record", "write_frame", "frame_diagnostics", "new_run_id"]
+__all__ = ["open_writer", "particle_field", "frame_record", "write_frame", "frame_diagnostics", "new_run_id",
+           "out_of_space"]
 
 
 def new_run_id() -> str:
@@ -52,8 +55,9 @@ def open_writer(sim, path: str) -> io.RunWriter:
                     "mass": g.mass, "vol0": g.vol0} for g in model.groups],
         "unit_system": "SI: m, s, kg, Pa, N, J",
         "grid": {"origin": list(model.origin), "shape": list(model.grid_shape), "dx": model.dx},
-        "run_id": sim.run_id,
     }
+    if sim.run_id is not None:
+        attrs["run_id"] = sim.run_id
     return io.RunWriter(path, n_particles=model.n_particles, particle_fields=pf, static_fields=static,
                         wall_names=model.wall_names, scalar_series=scalars, attrs=attrs)
 
@@ -124,3 +128,32 @@ def write_frame(sim, writer: io.RunWriter) -> None:
     """Append the frame ``sim`` is at to ``writer``."""
     t, steps, parts, forces, scalars = frame_record(sim)
     writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
+
+
+def out_of_space(err: io.OutOfSpace, output: str) -> io.OutOfSpace:
+    """``err`` (a write of run ``output`` found no room) told as what is safe and how to go on, in one line."""
+    n, t = getattr(err, "frames", None), getattr(err, "last_time", None)   # a frame's write: its writer knows
+    if n is None:
+        try:
+            run = io.read_run(output)
+            n, t = run.n_frames, float(run.times[-1]) if run.n_frames else None
+        except (io.OutputError, IndexError):
+            n = 0
+    safe = f"{n} complete frame{'s are' if n != 1 else ' is'} safe in {output}" + (f" (to t = {t:.6g} s)" if n else "")
+    try:
+        short = os.path.getsize(output) < (io.hdf5.stored_eof(output) or 0)
+    except OSError:
+        short = False
+    if short:                  # the failed flush left it short of its end, and there was no room to pad it
+        safe += " (readers refuse it as truncated until the resume pads its incomplete last frame)"
+    ckpt = io.checkpoint_path_for(output)
+    room = {errno.EDQUOT: "free space or raise the quota",
+            errno.EFBIG: "raise the file-size limit (ulimit -f)"}.get(err.errno, "free space")
+    if os.path.exists(ckpt) and io.checkpoint_is_intact(ckpt):
+        t = io.read_checkpoint_meta(ckpt)["time"]
+        how = f"{room}, then resume from its checkpoint (t = {t:.6g} s): mpm-warp resume {output}"
+    else:
+        how = f"there is no checkpoint to resume from: {room}, then run again with --overwrite"
+    out = io.OutOfSpace(err.path, err.errno, err.what)
+    out.args, out.frames = (f"{err}; {safe}; {how}",), n
+    return out

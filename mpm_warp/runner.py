@@ -17,6 +17,7 @@ from collections.abc import Callable
 from . import checks, io
 from .config import Scenario, check_end_time
 from .errors import InvalidArgument, OutputError
+from .io.hdf5 import pad_to_stored_eof
 from .loader import load_scenario, resolved_scenario, scenario_path
 from .result import RunResult
 from .scenes import attach
@@ -102,6 +103,12 @@ def run(scenario, output: str | None = None, device: str | None = None, override
         return sim.run(output, overwrite=overwrite, **run_kwargs)
 
 
+def _every_frame_reads(path: str) -> None:
+    run = io.read_run(path)
+    for i in range(run.n_frames):
+        run.frame(i)
+
+
 def resume(output, device: str | None = None, end_time: float | None = None, callback=None,
            n_threads: int | None = None, max_memory=None,
            on_start: Callable[[Simulation], None] | None = None) -> RunResult:
@@ -121,6 +128,8 @@ def resume(output, device: str | None = None, end_time: float | None = None, cal
     callback = checks.optional_callable("callback", callback)
     on_start = checks.optional_callable("on_start", on_start)
     with claimed_output(output, append=True) as output:
+        with contextlib.suppress(OSError):     # a run that found no room may have left its file short of its end
+            pad_to_stored_eof(output, _every_frame_reads)
         ckpt = io.checkpoint_path_for(output)
         if not os.path.exists(ckpt):
             raise OutputError(f"{output}: has no checkpoint {ckpt} to resume from")

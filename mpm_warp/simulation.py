@@ -14,11 +14,10 @@ from collections.abc import Callable
 import numpy as np
 import warp as wp
 
-from . import checks, io, snapshot
+from . import checks, frames, io, snapshot
 from .config import Scenario, check_end_time
 from .device import resolve_device
 from .errors import InvalidArgument, SimulationBlowUp
-from .frames import frame_diagnostics, frame_record, new_run_id, open_writer, particle_field, write_frame
 from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, health_zz_kernel, stress_kernel
 from .memory import check_memory
 from .model import Model, ParticleGroup, State, material_params
@@ -175,7 +174,7 @@ class Simulation:
 
     def particle_field(self, name: str) -> np.ndarray:
         """Host copy of one output field for all particles (:func:`mpm_warp.frames.particle_field`)."""
-        return particle_field(self, name)
+        return frames.particle_field(self, name)
 
     def health(self) -> None:
         """Run the device health check; raise SimulationBlowUp on failure."""
@@ -213,6 +212,7 @@ class Simulation:
         Steps run in batches sized from the current step size; between batches
         the host reads the clock and (every ``health_every`` steps) the health flags.
         """
+        t_end = checks.finite_number("t_end", t_end, lo=0.0)
         he = health_every or self.scenario.output.health_every
         self.stepper.set_frame_end(t_end)
         t, dt, steps0 = self.stepper.clock()
@@ -288,7 +288,10 @@ class Simulation:
             return self._run(None, end, fi, callback, append)
         output = io.check_output_file(output, overwrite=overwrite, append=append)
         with io.output_lock(output):
-            return self._run(output, end, fi, callback, append)
+            try:
+                return self._run(output, end, fi, callback, append)
+            except io.OutOfSpace as e:   # the complete frames and the checkpoint say how to go on
+                raise frames.out_of_space(e, output) from None
 
     def _run_times(self, end_time, frame_interval) -> tuple[float, float]:
         tc = self.scenario.time  # end and frame interval checked as time.end and time.frame_interval are
@@ -309,23 +312,23 @@ class Simulation:
                 # every frame is kept (restore() read them all): those after the checkpoint are stepped over
                 writer = io.RunWriter.reopen(output, verify=False)
             else:
-                self.run_id = new_run_id()
-                writer = open_writer(self, output)
-                write_frame(self, writer)
-                self._checkpoint(ckpt)
+                self.run_id = frames.new_run_id()
+                writer = frames.open_writer(self, output)
         elif not append:
-            frame_diagnostics(self)
+            frames.frame_diagnostics(self)
         if not append:
             self._last_frame_time = self.time
-        # warm up: compile every kernel before timing
-        self._compile()
         steps_total = 0
-        frames = 0
+        n_done = 0
         wall = 0.0
         edge0 = self.stepper.edge_count()[0]
         events0 = self.stepper.deformation_events()
         stopped = False
         try:
+            if writer is not None and not append:
+                frames.write_frame(self, writer)
+                self._checkpoint(ckpt)
+            self._compile()   # warm up: compile every kernel before timing
             while self.frame_index < n_frames_total:
                 t_next = min((self.frame_index + 1) * fi, end)
                 t0 = _time.perf_counter()
@@ -338,19 +341,19 @@ class Simulation:
                     stopped = True
                     break
                 self.frame_index += 1
-                frames += 1
+                n_done += 1
                 self.health()  # never write a bad state into a frame or a checkpoint
                 self._since_health = 0
                 if writer is not None:
                     if self.frame_index < writer.n_frames:   # on file already (after the checkpoint): kept
-                        frame_record(self)
+                        frames.frame_record(self)
                     else:
-                        write_frame(self, writer)
+                        frames.write_frame(self, writer)
                     ce = self.scenario.output.checkpoint_every
                     if ce and self.frame_index % ce == 0:
                         self._checkpoint(ckpt)
                 else:
-                    frame_diagnostics(self)
+                    frames.frame_diagnostics(self)
                 if (callback is not None and callback(self, self.frame_index) is False) or self._stop_now:
                     if writer is not None:
                         self._checkpoint(ckpt)  # a stop on request can be resumed from exactly here
@@ -370,7 +373,7 @@ class Simulation:
         for m in self.monitors.values():
             result.update(m.result())
         floors, inversions = (a - b for a, b in zip(self.stepper.deformation_events(), events0, strict=True))
-        return RunResult(output, steps_total, frames, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
+        return RunResult(output, steps_total, n_done, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
                          n, self.device, self.stepper.edge_count()[0] - edge0, result, dict(self.monitors),
                          floors, inversions, stopped)
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from helpers_bad_input import BASE, TIME_TABLE, expect, load_scenario_text, one_line, sub, write_scene
+from helpers_bad_input import BASE, TIME_TABLE, expect, load_scenario_text, one_line, run_cli, sub, write_scene
 
 import mpm_warp as mw
 from mpm_warp.cli import main
@@ -83,3 +83,64 @@ def test_step_budget_states_the_bound_and_the_estimate(tmp_path):
     expect(tmp_path, sub('material = "snow"', 'material = "snow"\nvelocity = [0.0, -8.0e3, 0.0]'),
             mw.InvalidArgument, "blocks[0].velocity", "at most 100 times", "7.34e+03 m/s", "Mach 109")
     assert load_scenario_text(tmp_path, sub('material = "snow"', 'material = "snow"\nvelocity = [0.0, -7.0e3, 0.0]'))
+
+
+def test_cli_fixed_dt_above_the_limit_one_line(tmp_path, capsys):
+    path = write_scene(tmp_path, sub("cfl = 0.4", "dt = 0.01").replace("end = 0.01", "end = 0.05"))
+    line = run_cli(["run", path, "--quiet", "--out", str(tmp_path / "r.h5")], capsys)
+    assert "time.dt = 0.01 is invalid" in line and "stability limit 1.11 dx / c_p" in line
+    assert not (tmp_path / "r.h5").exists()
+
+
+# ------------------------------------------------------------------ sweep --cases
+@pytest.mark.parametrize("content, needles", [
+    (b"time.end,time.cfl\n0.01\n", ("cases row (line 2 of", "['0.01']", "2 values", "it has 1")),
+    (b"time.end\n0.01,0.3\n", ("cases row (line 2 of", "1 values", "it has 2")),
+    (b"time.end,time.cfl\n0.01,0.3\n0.02,0.3,9\n", ("line 3 of", "it has 3")),
+    (b"", ("it has nothing",)),
+    (b"time.end\n\n", ("it has a header only",)),
+    (b"time.end,\n0.01,\n", ("cases header", "non-empty",)),
+    (b"time.end,time.end\n0.01,0.02\n", ("cases header", "distinct")),
+    (b"time.end\n0.01\n\xff\xfe\n", ("a UTF-8 CSV file (byte",)),
+], ids=["short-row", "long-row", "long-later-row", "empty", "header-only", "empty-key", "duplicate-key", "not-utf8"])
+def test_cli_sweep_cases_one_line(tmp_path, capsys, content, needles):
+    """Rows of the wrong length ran silently (a short row without its value, an extra value dropped), an empty
+    file gave "0 runs" with exit 0, a non-UTF-8 file a UnicodeDecodeError: one line naming the row, exit 2, no run."""
+    cases = tmp_path / "cases.csv"
+    cases.write_bytes(content)
+    line = run_cli(["sweep", "elastic_block", "--cases", str(cases), "--out", str(tmp_path / "sw"), "--quiet"], capsys)
+    assert line.startswith("mpm-warp: error: cases")
+    for n in needles:
+        assert n in line, (n, line)
+    assert not (tmp_path / "sw").exists()
+
+
+# ------------------------------------------------------------------ a signal before stepping starts
+def test_sigterm_before_stepping_ends_at_once(tmp_path):
+    """SIGTERM while the scenario is read (a 16 MB file: seconds of parsing) ends the command at once, exit 143, one
+    line, the lock released: before, it was taken as "stop after the current batch" of a run not started yet, and
+    it took three signals to end."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    path = tmp_path / "big.toml"
+    path.write_text(BASE.replace('description = "', 'junk = [' + ",".join(["0.5"] * 4_000_000) + ']\ndescription = "'))
+    out = tmp_path / "r.h5"
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    proc = subprocess.Popen([sys.executable, "-m", "mpm_warp.cli", "run", str(path), "--out", str(out), "--quiet"],
+                            stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": root})
+    deadline = time.time() + 120
+    while not os.path.exists(str(out) + ".lock") and time.time() < deadline and proc.poll() is None:
+        time.sleep(0.01)                           # the output is claimed before the scenario is read
+    assert proc.poll() is None, proc.stderr.read()
+    t0 = time.perf_counter()
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    waited = time.perf_counter() - t0
+    lines = [ln for ln in err.splitlines() if "CUDA" not in ln]
+    assert proc.returncode == 128 + signal.SIGTERM and waited < 3.0, (proc.returncode, waited, err)
+    assert lines == ["mpm-warp: interrupted (SIGTERM); complete frames are kept in the output file"]
+    assert not os.path.exists(str(out) + ".lock") and not out.exists()

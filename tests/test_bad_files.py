@@ -68,6 +68,24 @@ def _case_scenario_dir(made, tmp):
     return ["run", str(tmp)], ("is a directory",)
 
 
+def _case_scenario_fifo(made, tmp):
+    """A FIFO with no writer: opening it would wait for ever (it hung for 643 s); refused before it is opened."""
+    os.mkfifo(tmp / "fifo.toml")
+    return ["run", str(tmp / "fifo.toml"), "--out", str(tmp / "run.h5")], ("fifo.toml: is not a regular file",)
+
+
+def _case_scenario_device(made, tmp):
+    return ["run", "/dev/zero"], ("/dev/zero: is not a regular file",)
+
+
+def _case_scenario_socket(made, tmp):
+    import socket
+
+    s = socket.socket(socket.AF_UNIX)
+    s.bind(str(tmp / "sock.toml"))                 # left bound: the path is a socket while the CLI looks at it
+    return ["run", str(tmp / "sock.toml")], ("sock.toml: is not a regular file",)
+
+
 def _case_out_dir(made, tmp):
     (tmp / "out").mkdir()
     return ["run", str(made / "scene.toml"), "--out", str(tmp / "out")], ("is a directory",)
@@ -174,7 +192,9 @@ def _damaged(command, how):
 
 FILE_CASES = [
     ("binary-scenario", _case_binary), ("utf16-scenario", _case_utf16), ("nested-500", _case_nested),
-    ("scenario-is-directory", _case_scenario_dir), ("out-is-directory", _case_out_dir),
+    ("scenario-is-directory", _case_scenario_dir), ("scenario-fifo", _case_scenario_fifo),
+    ("scenario-device", _case_scenario_device), ("scenario-socket", _case_scenario_socket),
+    ("out-is-directory", _case_out_dir),
     ("out-missing-folder", _case_out_missing_dir), ("out-read-only-folder", _case_out_read_only),
     ("out-exists", _case_out_exists), ("out-is-the-scenario", _case_out_is_scenario), ("out-fifo", _case_out_fifo),
     ("out-dev-null", _case_out_dev_null), ("memory-40m-domain", _case_memory_domain),

@@ -172,6 +172,9 @@ def test_nan_and_inf(tmp_path, text, field, value):
     pytest.param(sub('material = "snow"', 'material = "snow"\nvelocity = [1.0e6, 0.0, 0.0]'), "blocks[0].velocity",
                  "1000000.0", id="speed-1e6"),
     pytest.param(sub("cfl = 0.4", "dt = 1e-12"), "time.dt", "1e-12", id="fixed-dt-1e-12"),
+    pytest.param(sub("cfl = 0.4", "dt = 1e-3"), "time.dt", "0.001", id="fixed-dt-above-the-stability-limit"),
+    pytest.param(sub("cfl = 0.4", "dt = 1e-4\nallow_unstable_dt = 1"), "time.allow_unstable_dt", "1",
+                 id="allow-unstable-dt-not-a-bool"),
 ])
 def test_out_of_range_values(tmp_path, text, field, value):
     """Out of range: InvalidArgument with the field, the value and the allowed range ('expected ...')."""
@@ -259,3 +262,19 @@ def test_python_api_bad_values(change, field):
         mw.Simulation(sc, device="cpu")
     assert info.value.field == field
     assert field in str(info.value)
+
+
+def test_fixed_dt_above_the_stability_limit_names_it(tmp_path):
+    """c_p = sqrt(E (1 - nu) / ((1 + nu)(1 - 2 nu)) / rho) = 73.4 m/s for E = 1 MPa, nu = 0.3, rho = 250: the limit
+    1.11 dx / c_p = 3.03e-4 s at dx = 2 cm (measured: 1.10 stable, 1.12 blowing up). The issue's step, 92 times the
+    CFL step 0.4 dx / c_p = 1.09e-4 s (it ran 4 steps to 253 Pa and exit 0), is refused up front; the limit itself
+    passes, and allow_unstable_dt (stability studies) lets a larger step through."""
+    c_p = mw.Elastic(1.0e6, 0.3, 250.0).p_wave_speed
+    assert c_p == pytest.approx(73.38, rel=1e-3)
+    dt92 = 92 * 0.4 * 0.02 / c_p
+    err = expect(tmp_path, sub("cfl = 0.4", f"dt = {dt92!r}").replace("end = 0.01", "end = 0.05"), mw.InvalidArgument,
+                 "time.dt", "stability limit 1.11 dx / c_p = 0.000303 s", "dx = 0.02 m", "c_p = 73.4 m/s",
+                 "materials.snow", "it is 33.2 times that", "allow_unstable_dt")
+    assert err.value == pytest.approx(dt92)
+    assert load_scenario_text(tmp_path, sub("cfl = 0.4", f"dt = {1.11 * 0.02 / c_p!r}")).time.dt > 0
+    assert load_scenario_text(tmp_path, sub("cfl = 0.4", "dt = 1e-3\nallow_unstable_dt = true")).time.dt == 1e-3

@@ -127,3 +127,56 @@ def test_overwrite_must_be_a_bool(finished, tmp_path, value):
         mw.Simulation(mw.load_scenario("elastic_block", SETS), device="cpu").run(path, overwrite=value)
     assert _files(tmp_path) == before
     assert math.isfinite(mw.read_run(path).times[-1])
+
+
+# ------------------------------------------------------------------ a checkpoint resumes only its own run file
+def _pair(d, sets, name="run", old=False, monkeypatch=None):
+    """A run of the elastic block (its file and checkpoint in ``d``); ``old``: written without a run id."""
+    if old:
+        monkeypatch.setattr(mw.frames, "new_run_id", lambda: None)
+    out = str(d / f"{name}.h5")
+    mw.run("elastic_block", out, "cpu", sets)
+    if old:
+        monkeypatch.undo()
+    return out
+
+
+def test_run_id_in_the_file_and_its_checkpoints(finished):
+    rid = mw.read_run(str(finished / "run.h5")).attrs["run_id"]
+    assert isinstance(rid, str) and len(rid) == 32 and int(rid, 16) >= 0
+    assert io.read_checkpoint_meta(str(finished / "run.ckpt.h5"))["run_id"] == rid
+    assert mw.read_run(str(finished / "long.h5")).attrs["run_id"] != rid
+
+
+def test_checkpoint_of_another_run_is_refused(finished, tmp_path, capsys):
+    """The issue's case: the checkpoint of another run of the same scene, with another frame interval, rewrote the
+    file with mixed frame intervals. Refused in one line, nothing changed."""
+    path = _copy(finished, tmp_path)
+    (tmp_path / "other").mkdir()
+    other = _pair(tmp_path / "other", SETS[:1] + ["time.frame_interval=0.01", "output.checkpoint_every=1"])
+    shutil.copy(io.checkpoint_path_for(other), io.checkpoint_path_for(path))
+    before = _files(tmp_path)
+    assert main(["resume", path, "--quiet", "--end", "0.03"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "run.ckpt.h5: is not the checkpoint of" in err and "run_id" in err
+    assert "it would mix two runs in one file" in err
+    assert _files(tmp_path) == before
+
+
+def test_files_without_run_id(tmp_path, monkeypatch):
+    """Files written before run ids existed: resumed when the checkpoint's scenario is the run file's (bit for bit),
+    refused when it is another's; a run file with an id never takes a checkpoint without one."""
+    old = _pair(tmp_path, SETS, "old", old=True, monkeypatch=monkeypatch)
+    assert "run_id" not in mw.read_run(old).attrs and io.read_checkpoint_meta(io.checkpoint_path_for(old))["run_id"] \
+        is None
+    res = mw.resume(old, device="cpu", end_time=0.03)
+    assert res.sim_time == pytest.approx(0.03)
+    long = _pair(tmp_path, SETS + ["time.end=0.03"], "long")
+    assert_same_frames(long, old)
+    other = _pair(tmp_path, SETS[:1] + ["time.frame_interval=0.01"], "other", old=True, monkeypatch=monkeypatch)
+    shutil.copy(io.checkpoint_path_for(other), io.checkpoint_path_for(old))
+    with pytest.raises(mw.OutputError, match=r"is not the checkpoint of .*its scenario differs from the run file's"):
+        mw.resume(old, device="cpu", end_time=0.06)
+    shutil.copy(io.checkpoint_path_for(other), io.checkpoint_path_for(long))     # an id in the file, none in it
+    with pytest.raises(mw.OutputError, match=r"is not the checkpoint of .*run_id None, the run file's is [0-9a-f]{32}"):
+        mw.resume(long, device="cpu", end_time=0.06)

@@ -114,11 +114,10 @@ def test_stop_request_decides_between_the_frame_and_the_next_batch(capsys):
         assert sim.stops == 1
         with pytest.raises(KeyboardInterrupt):          # a third: at once
             stop._handle(signal.SIGTERM, None)
-    with StopRequest(far_s=2.0) as stop:                # a signal before the simulation exists
-        stop._handle(signal.SIGINT, None)
-        sim = _Sim()
-        stop.attach(sim)
-        assert sim.stops == 1
+    with StopRequest(far_s=2.0) as stop:                # a signal before the simulation exists: ends at once
+        with pytest.raises(KeyboardInterrupt) as info:
+            stop._handle(signal.SIGTERM, None)
+        assert info.value.signum == signal.SIGTERM and stop.sim is None
     err = capsys.readouterr().err
     assert "finishing the current frame" in err and "stopping after the current batch of steps" in err
 

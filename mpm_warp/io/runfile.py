@@ -54,8 +54,10 @@ write ordering).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import uuid
 
 import h5py
 import numpy as np
@@ -74,13 +76,19 @@ from .hdf5 import (
     layout,
     now,
     open_read,
+    pad_to_stored_eof,
     series_chunk,
     series_datasets,
     set_attrs,
 )
 from .opening import reading
+from .space import as_out_of_space, ensure_space, space_errno, write_image
 
 __all__ = ["RunWriter"]
+
+#: free space a write needs beyond its raw bytes and a page per dataset: HDF5's metadata pages (chunk indices,
+#: object headers), bytes
+_METADATA_MARGIN = 16 * PAGE
 
 
 class RunWriter:
@@ -158,6 +166,11 @@ class RunWriter:
         if len(set(names)) < len(names):
             raise InvalidArgument("field names", names, "names unique across particle fields, "
                                   "scalars, static fields and 'wall_forces'")
+        #: the most bytes one frame adds to the file (its rows uncompressed, and a page per dataset)
+        rows = sum(self.n_particles * dt.itemsize * int(np.prod(sh)) for sh, dt, _ in self._fields.values())
+        self._frame_bytes = rows + 8 * (len(self._scalars) + 2) + 24 * len(self.wall_names) \
+            + PAGE * (len(self._fields) + len(self._scalars) + 3) + _METADATA_MARGIN
+        self._failed, self._last_time = False, None
         attrs = dict(attrs or {})
         if RESERVED_ATTRS & attrs.keys():
             raise InvalidArgument("attrs keys", sorted(RESERVED_ATTRS & attrs.keys()),
@@ -210,9 +223,44 @@ class RunWriter:
 
     def _build(self, static, attrs, compression, src=None, keep=0) -> h5py.File:
         """Write the file aside, with the first ``keep`` frames of ``src`` if given, switch it to
-        SWMR mode and move it over ``path``: a kill leaves the old file or the new one."""
+        SWMR mode and move it over ``path``: a kill leaves the old file or the new one.
+
+        Its layout (and the small series of the kept frames) is built in memory and written with
+        plain writes (:func:`_skeleton`), so a full disk there is one clean error; HDF5 itself then
+        writes only the kept particle frames, after a check that the space for them is free.
+        """
         part = self.path + ".part"
-        f = h5py.File(part, "w", libver=LIBVER, fs_strategy="page", fs_page_size=PAGE)
+        need = sum(a.nbytes for a, _ in static.values()) + self._frame_bytes + _METADATA_MARGIN   # and a first frame
+        ensure_space(self.path, need + (os.path.getsize(self.path) if src and keep else 0),
+                     "the run file" + (f" rebuilt with its {keep} frames" if src and keep else ""))
+        f = None
+        try:
+            write_image(part, self._skeleton(static, attrs, compression, src, keep))
+            f = h5py.File(part, "r+", libver=LIBVER)
+            if src and keep:
+                for name in self._fields:
+                    self._copy_chunks(src[f"particles/{name}"], f[f"particles/{name}"], keep)
+            f.swmr_mode = True                # flushes; from here on datasets only grow
+            os.replace(part, self.path)
+            return f
+        except BaseException as e:
+            if f is not None:
+                try:
+                    f.close()
+                except Exception:             # a close that cannot flush (a full disk): the file is removed anyway
+                    pass
+            if os.path.lexists(part):
+                os.remove(part)
+            err = as_out_of_space(e, self.path, "the run file")
+            if err is e:
+                raise
+            raise err from None
+
+    def _skeleton(self, static, attrs, compression, src, keep) -> bytes:
+        """The new file's bytes, built in memory: every dataset (``keep`` frames long), the static fields and,
+        from ``src``, the kept frames of every series but the particle fields (:meth:`_copy_chunks` writes those)."""
+        f = h5py.File(f"{self.path}.skeleton-{uuid.uuid4().hex}", "w", driver="core", backing_store=False,
+                      libver=LIBVER, fs_strategy="page", fs_page_size=PAGE)
         try:
             f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, n_particles=self.n_particles,
                            created=src.attrs["created"] if src else now())
@@ -227,22 +275,10 @@ class RunWriter:
                 d = f.create_dataset(name, shape=(keep, *shape), maxshape=(None, *shape), dtype=dtype,
                                      chunks=(chunk, *shape), fletcher32=True, **kw)
                 d.attrs["unit"] = unit
-                if not (src and keep):
-                    return d
-                s = src[name]
-                with reading(self.path, f"{name}, in the {keep} frames the resume keeps"):
-                    if chunk == 1 and s.chunks == d.chunks and \
-                            (s.compression, s.shuffle, s.fletcher32) == (d.compression, d.shuffle, d.fletcher32):
-                        for i in range(s.id.get_num_chunks()):   # copy compressed bytes as is, once verified
-                            info = s.id.get_chunk_info(i)
-                            if info.chunk_offset[0] < keep:
-                                if self._verify:
-                                    s[info.chunk_offset[0]]          # decompress: the checksum is checked
-                                raw = s.id.read_direct_chunk(info.chunk_offset)[1]
-                                d.id.write_direct_chunk(info.chunk_offset, raw, info.filter_mask)
-                    else:
+                if src and keep and not name.startswith("particles/"):
+                    with reading(self.path, f"{name}, in the {keep} frames the resume keeps"):
                         for i in range(0, keep, chunk):
-                            d[i:i + chunk] = s[i:min(i + chunk, keep)]
+                            d[i:i + chunk] = src[name][i:min(i + chunk, keep)]
                 return d
 
             series("time", "f8", "s")
@@ -259,13 +295,27 @@ class RunWriter:
             if self.wall_names:
                 series("walls/forces", "f8", "N", (len(self.wall_names), 3)).attrs["names"] = \
                     json.dumps(self.wall_names)
-            f.swmr_mode = True                # flushes; from here on datasets only grow
-            os.replace(part, self.path)
-            return f
-        except BaseException:
+            f.flush()
+            return f.id.get_file_image()
+        finally:
             f.close()
-            os.remove(part)
-            raise
+
+    def _copy_chunks(self, s: h5py.Dataset, d: h5py.Dataset, keep: int) -> None:
+        """The first ``keep`` frames of particle dataset ``s`` into ``d`` (same layout: raw compressed chunks, each
+        read once first when :attr:`_verify`, so that its checksum is checked)."""
+        with reading(self.path, f"{s.name.lstrip('/')}, in the {keep} frames the resume keeps"):
+            if s.chunks == d.chunks and (s.compression, s.shuffle, s.fletcher32) == \
+                    (d.compression, d.shuffle, d.fletcher32):
+                for i in range(s.id.get_num_chunks()):
+                    info = s.id.get_chunk_info(i)
+                    if info.chunk_offset[0] < keep:
+                        if self._verify:
+                            s[info.chunk_offset[0]]          # decompress: the checksum is checked
+                        raw = s.id.read_direct_chunk(info.chunk_offset)[1]
+                        d.id.write_direct_chunk(info.chunk_offset, raw, info.filter_mask)
+            else:
+                for i in range(keep):
+                    d[i] = s[i]
 
     @property
     def n_frames(self) -> int:
@@ -324,24 +374,50 @@ class RunWriter:
             rows["walls/forces"] = w
         rows["step"], rows["time"] = int(step), time          # time is written last
         n = self._n
-        for name, value in rows.items():
-            self._datasets[name].resize(n + 1, axis=0)
-            self._datasets[name][n] = value
-        self._f.flush()
-        self._n = n + 1
+        if self._failed:
+            raise OutputError(f"{self.path}: a write failed before; the writer holds {n} complete frames and "
+                              "writes no more")
+        ensure_space(self.path, self._frame_bytes, f"frame {n}")
+        try:
+            for name, value in rows.items():
+                self._datasets[name].resize(n + 1, axis=0)
+                self._datasets[name][n] = value
+            self._f.flush()
+        except Exception as e:
+            err = as_out_of_space(e, self.path, f"frame {n}")
+            if err is e:
+                raise
+            self._failed = True
+            err.frames, err.last_time = n, self._last_time
+            raise err from None
+        self._n, self._last_time = n + 1, time
         return n
 
     def close(self) -> None:
-        """Trim a partly written frame (left by an exception) and close the file."""
+        """Trim a partly written frame (left by an exception) and close the file.
+
+        After a write that found no room the trim and the close's flush may fail too: they are
+        given up quietly (readers take the complete frames, ``min`` of the lengths, either way).
+        """
         if self._f is None:
             return
+        f, self._f, trim_error = self._f, None, None
         try:
             for d in self._datasets.values():
                 if d.shape[0] != self._n:
                     d.resize(self._n, axis=0)
-        finally:
-            self._f.close()
-            self._f = None
+        except BaseException as e:
+            trim_error = e
+        try:
+            f.close()
+        except Exception as e:
+            if not (self._failed or space_errno(e)):
+                raise
+        if self._failed:                      # a flush that found no room may have left the file short of its end
+            with contextlib.suppress(OSError):
+                pad_to_stored_eof(self.path)
+        if trim_error is not None and not (self._failed or space_errno(trim_error)):
+            raise trim_error
 
     def __enter__(self) -> RunWriter:
         return self

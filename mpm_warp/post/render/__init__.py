@@ -79,6 +79,8 @@ def parse_frames(spec, n_frames: int) -> list[int]:
         for p in spec.split(",") if isinstance(spec, str) else np.atleast_1d(spec).tolist():
             if isinstance(p, str) and ":" in p:
                 items += list(range(n_frames))[slice(*[int(s) if s.strip() else None for s in p.split(":")])]
+            elif isinstance(p, (bool, float)):
+                raise TypeError("a frame index is a whole number")
             else:
                 items.append(int(p))
     except (TypeError, ValueError) as e:
@@ -135,9 +137,7 @@ def render_run(path, field: str = "collapse", frames=None, out_dir=None, video=F
         raise InvalidArgument("camera", camera, f"one of {list(CAMERAS)}")
     if video not in (False, True, "gif", "mp4", None):
         raise InvalidArgument("video", video, "False, True, 'gif' or 'mp4'")
-    w, h = (int(s) for s in size)
-    if w < 64 or h < 64:
-        raise InvalidArgument("size", size, "(width, height) of at least 64 x 64 pixels")
+    w, h = _size(size)
     setup_gl()
     if video == "mp4":
         ffmpeg()                              # fail before rendering, not after
@@ -158,7 +158,7 @@ def render_run(path, field: str = "collapse", frames=None, out_dir=None, video=F
         # 1 - J_P < 0 is dilation (a sawn cut stores log_jp >> 0): kept out of the range, drawn grey
         clim = (max(data_range[0], 0.0), min(data_range[1], 1.0))
         clim = clim if clim[0] < clim[1] else (clim[0], clim[0] + 1e-3)
-    clim = data_range if clim is None else (float(clim[0]), float(clim[1]))
+    clim = data_range if clim is None else _pair("clim", clim)
     if not clim[0] < clim[1]:
         raise InvalidArgument("clim", clim, "(low, high) with low < high")
     kind = str(((run.scenario or {}).get("scene") or {}).get("kind", "blocks"))
@@ -199,6 +199,25 @@ def render_run(path, field: str = "collapse", frames=None, out_dir=None, video=F
     with open(meta_path, "w") as f:
         json.dump(meta, f, indent=1)
     return Rendered(pngs, movie, meta, meta_path)
+
+
+def _size(size) -> tuple[int, int]:
+    try:
+        w, h = (int(s) for s in size)
+        ok = all(float(s) == int(s) for s in size)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok or w < 64 or h < 64:
+        raise InvalidArgument("size", size, "(width, height): whole numbers of pixels, at least 64 x 64")
+    return w, h
+
+
+def _pair(field: str, value) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise InvalidArgument(field, value, "(low, high), two numbers") from None
+    return lo, hi
 
 
 def _positive_fps(fps) -> float:
