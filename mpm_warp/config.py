@@ -11,13 +11,13 @@ the field, the value and the allowed range). Reading TOML files, overrides and s
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal, Protocol, get_args, runtime_checkable
 
 from .checks import choice, finite_number, positive_int, vector
 from .errors import InvalidArgument
 from .materials import Elastic
+from .time_step import MAX_MACH, MAX_STEPS, STABLE_DT, check_end_time, first_step, step_budget
 from .walls import WALL_KINDS, WallKind
 
 __all__ = ["Block", "Domain", "TimeControl", "Output", "Scenario", "SceneParams", "OUTPUT_FIELDS", "PRECISIONS",
@@ -32,14 +32,6 @@ BOUNDARIES: tuple[str, ...] = (*WALL_KINDS, "none")
 OnInversion = Literal["report", "stop"]
 #: what a run does when P2G floors singular values or meets an inverted element (``Output.on_inversion``)
 ON_INVERSION: tuple[str, ...] = get_args(OnInversion)
-#: most steps a run may need (its first step size times this reaches time.end): far beyond any snow experiment
-#: (a PST of 1 s at dx = 2 mm takes ~1e6), so more means a typo in a modulus, a density, a speed or a time
-MAX_STEPS = 1.0e8
-#: fastest initial speed, in multiples of the fastest P-wave speed of the materials (snow: 70-300 m/s)
-MAX_MACH = 100.0
-#: the stability limit of a fixed step, in dx / c_p: measured 1.10 stable, 1.12 blowing up (docs/robustness.md);
-#: a larger ``time.dt`` is refused unless ``time.allow_unstable_dt``
-STABLE_DT = 1.11
 #: particle fields the output may hold: name -> (per-particle shape, unit, description); "dim" is the scene's dimension
 OUTPUT_FIELDS = {
     "x": (("dim",), "m", "position"),
@@ -250,7 +242,7 @@ class Scenario:
         if self.scene is not None and not isinstance(self.scene, SceneParams):
             raise InvalidArgument("scene", self.scene, "typed scene parameters (e.g. mpm_warp.scenes.pst.PSTParams) "
                                   "or None; a scenario file's [scene] table is read by mpm_warp.loader")
-        _step_budget(tc, dom.dx, mats, blocks)
+        step_budget(tc, dom.dx, mats, blocks)
         return replace(self, domain=dom, time=tc, materials=mats, blocks=blocks, walls=walls, output=outp)
 
     def to_dict(self) -> dict:
@@ -346,66 +338,3 @@ def _flag(field: str, value) -> bool:
     if not isinstance(value, bool):
         raise InvalidArgument(field, value, "true or false")
     return value
-
-
-def first_step(tc: TimeControl, dx: float, mats: dict, blocks) -> tuple[float, str, Any, str, float, str]:
-    """The first step of a run, for the budget and stability checks (validated time, materials and blocks).
-
-    ``dt = cfl dx / (c_p + |v|)`` (``time.dt`` if fixed, capped by ``time.dt_max``) with ``c_p`` the
-    fastest P-wave speed of the materials in use and ``|v|`` the fastest constant initial speed (a
-    Python velocity function is not evaluated here).
-
-    Returns
-    -------
-    (dt [s], the field that sets it, its value, how it is set (words), c_p [m/s], the material's name)
-    """
-    name, fastest = max(((k, m) for k, m in mats.items() if any(b.material == k for b in blocks)),
-                        key=lambda km: km[1].p_wave_speed)
-    c_p = fastest.p_wave_speed
-    vmax = max((math.sqrt(sum(c * c for c in b.velocity)) for b in blocks if not callable(b.velocity)), default=0.0)
-    if tc.dt > 0:
-        dt, field, value, why = tc.dt, "time.dt", tc.dt, "the fixed step"
-    else:
-        dt = tc.cfl * dx / (c_p + vmax)
-        field, value = f"materials.{name} (E, density)", (fastest.E, fastest.density)
-        why = (f"dt = cfl dx / (c_p + |v|) = {tc.cfl:g} x {dx:g} m / ({c_p:.3g} + {vmax:.3g} m/s) with c_p = "
-               f"{c_p:.3g} m/s of materials.{name}")
-    if tc.dt_max > 0 and tc.dt_max < dt:
-        dt, field, value, why = tc.dt_max, "time.dt_max", tc.dt_max, "the step cap time.dt_max"
-    return dt, field, value, why, c_p, name
-
-
-def _step_budget(tc: TimeControl, dx: float, mats: dict, blocks) -> None:
-    """Refuse speeds, moduli and densities that would make a run take more than :data:`MAX_STEPS` steps,
-    an initial speed above :data:`MAX_MACH` ``c_p``, and a fixed step above the stability limit
-    :data:`STABLE_DT` ``dx / c_p`` (unless ``time.allow_unstable_dt``)."""
-    dt, field, value, why, c_p, name = first_step(tc, dx, mats, blocks)
-    for i, b in enumerate(blocks):
-        if callable(b.velocity):
-            continue
-        speed = math.sqrt(sum(c * c for c in b.velocity))
-        if speed > MAX_MACH * c_p:
-            raise InvalidArgument(f"blocks[{i}].velocity", b.velocity, (
-                f"a speed at most {MAX_MACH:g} times the fastest P-wave speed, {MAX_MACH * c_p:.3g} m/s "
-                f"(c_p = {c_p:.3g} m/s of materials.{name}); |v| = {speed:.3g} m/s is Mach {speed / c_p:.3g}"))
-    limit = STABLE_DT * dx / c_p
-    if tc.dt > limit and not tc.allow_unstable_dt:
-        raise InvalidArgument("time.dt", tc.dt, (
-            f"a fixed step at most the stability limit {STABLE_DT:g} dx / c_p = {limit:.3g} s (dx = {dx:g} m, c_p = "
-            f"{c_p:.3g} m/s of materials.{name}); it is {tc.dt / limit:.3g} times that (0 = the automatic step, "
-            "or time.allow_unstable_dt = true for a stability study)"))
-    steps = tc.end / dt
-    if steps > MAX_STEPS:
-        raise InvalidArgument(field, value, f"values giving at most {MAX_STEPS:.0e} steps to time.end = {tc.end:g} s: "
-                              f"{why} makes dt = {dt:.3g} s and {steps:.3g} steps")
-
-
-def check_end_time(scenario: Scenario, value, field: str = "end_time") -> float:
-    """An end time [s] given beside a validated ``scenario`` (``Simulation.run``, ``resume``), checked as
-    ``time.end`` is: a finite number > 0 whose run takes at most :data:`MAX_STEPS` steps."""
-    end = finite_number(field, value, lo=0.0, lo_open=True)
-    dt, _, _, why, _, _ = first_step(scenario.time, scenario.domain.dx, scenario.materials, scenario.blocks)
-    if end / dt > MAX_STEPS:
-        raise InvalidArgument(field, value, f"a time giving at most {MAX_STEPS:.0e} steps: {why} makes dt = "
-                              f"{dt:.3g} s and {end / dt:.3g} steps")
-    return end

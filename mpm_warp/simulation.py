@@ -15,7 +15,7 @@ import numpy as np
 import warp as wp
 
 from . import checks, frames, io, snapshot
-from .config import Scenario, check_end_time
+from .config import Scenario
 from .device import resolve_device
 from .errors import InvalidArgument, SimulationBlowUp
 from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, health_zz_kernel, stress_kernel
@@ -24,6 +24,7 @@ from .model import Model, ParticleGroup, State, material_params
 from .monitor import GroupState, Monitor
 from .result import RunResult
 from .step import Stepper
+from .time_step import run_times
 
 __all__ = ["Simulation"]
 
@@ -273,7 +274,7 @@ class Simulation:
         with one it is refused (a run file starts at the initial state; :func:`~mpm_warp.resume` it).
         """
         output = checks.file_path("output", output, none=True)
-        end, fi = self._run_times(end_time, frame_interval)
+        end, fi = run_times(self.scenario, end_time, frame_interval)
         callback = checks.optional_callable("callback", callback)
         append, overwrite = checks.flag("append", append), checks.flag("overwrite", overwrite)
         if not append and self.time > 0.0:
@@ -292,16 +293,6 @@ class Simulation:
                 return self._run(output, end, fi, callback, append)
             except io.OutOfSpace as e:   # the complete frames and the checkpoint say how to go on
                 raise frames.out_of_space(e, output) from None
-
-    def _run_times(self, end_time, frame_interval) -> tuple[float, float]:
-        tc = self.scenario.time  # end and frame interval checked as time.end and time.frame_interval are
-        end = tc.end if end_time is None else check_end_time(self.scenario, end_time)
-        if frame_interval is None:
-            return end, tc.frame_interval
-        fi = checks.finite_number("frame_interval", frame_interval, lo=0.0, lo_open=True)
-        if fi > end:
-            raise InvalidArgument("frame_interval", frame_interval, f"at most the end time {end:g} s")
-        return end, fi
 
     def _run(self, output, end, fi, callback, append) -> RunResult:
         writer = None

@@ -73,11 +73,12 @@ def check_identity(output: str, ckpt: str, run_attrs: dict, meta: dict) -> None:
     """Refuse a checkpoint that is not of this run file: their ``run_id`` differ (or one of them has none).
 
     Files written before run ids existed (neither has one) are accepted when the checkpoint's scenario
-    equals the run file's (frame interval, materials, scene: all of it), else refused the same way.
+    equals the run file's (frame interval, materials, scene: every key both hold; a key a later version
+    added to its checkpoints is not a difference), else refused the same way.
     """
     mine, theirs = run_attrs.get("run_id"), meta.get("run_id")
     if mine is None and theirs is None:
-        same = _plain(run_attrs.get("scenario")) == _plain(meta.get("scenario"))
+        same = _alike(_plain(run_attrs.get("scenario")), _plain(meta.get("scenario")))
         why = "its scenario differs from the run file's"
     else:
         same = mine == theirs
@@ -85,6 +86,15 @@ def check_identity(output: str, ckpt: str, run_attrs: dict, meta: dict) -> None:
     if not same:
         raise OutputError(f"{ckpt}: is not the checkpoint of {output} ({why}): resume refused, it would mix two runs "
                           "in one file")
+
+
+def _alike(a, b) -> bool:
+    """``a == b``, where two dicts are compared on the keys both hold."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return all(_alike(a[k], b[k]) for k in a.keys() & b.keys())
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_alike(x, y) for x, y in zip(a, b, strict=True))
+    return a == b
 
 
 def _plain(scenario) -> object:

@@ -7,9 +7,11 @@ holds one frame (0.02 s) after its checkpoint, as a run killed between two check
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 
+import h5py
 import numpy as np
 import pytest
 
@@ -169,8 +171,12 @@ def test_files_without_run_id(tmp_path, monkeypatch):
     old = _pair(tmp_path, SETS, "old", old=True, monkeypatch=monkeypatch)
     assert "run_id" not in mw.read_run(old).attrs and io.read_checkpoint_meta(io.checkpoint_path_for(old))["run_id"] \
         is None
-    res = mw.resume(old, device="cpu", end_time=0.03)
-    assert res.sim_time == pytest.approx(0.03)
+    with h5py.File(old, "r+") as f:               # as an older version wrote it: no time.allow_unstable_dt
+        sc = json.loads(f.attrs["scenario"])
+        del sc["time"]["allow_unstable_dt"]
+        f.attrs["scenario"] = json.dumps(sc)
+    assert mw.resume(old, device="cpu", end_time=0.025).sim_time == pytest.approx(0.025)
+    assert mw.resume(old, device="cpu", end_time=0.03).sim_time == pytest.approx(0.03)   # its checkpoint has the key
     long = _pair(tmp_path, SETS + ["time.end=0.03"], "long")
     assert_same_frames(long, old)
     other = _pair(tmp_path, SETS[:1] + ["time.frame_interval=0.01"], "other", old=True, monkeypatch=monkeypatch)

@@ -18,46 +18,20 @@ data: ``"gzip"`` = shuffle + gzip level 1 (any HDF5 tool reads it; level 4 was n
 10-30 % slower), ``"lzf"`` = shuffle + LZF (about 3.5x faster to write, ~10 % larger, an
 h5py-only filter), ``"none"``.
 
-Crash safety: a frame is written whole or not at all
-----------------------------------------------------
-Files use superblock v3 (``libver="v110"``, read by HDF5 >= 1.10) and are written in SWMR
-mode, in which HDF5 orders its metadata writes (flush dependencies) so that the file is
-consistent after any prefix of them, and ``H5Fflush`` writes raw chunks before metadata.
-:meth:`RunWriter.write_frame` checks every input, grows and fills each per-frame dataset
-(``time`` last) and flushes. A frame is complete when every per-frame dataset holds its row;
-readers take ``n_frames = min(lengths)``, so a kill between two dataset headers, or an
-exception between two datasets, never shows a partial frame. A file is never touched outside
-SWMR mode: it is built aside (``<path>.part``), switched to SWMR, then renamed over ``path``.
-A killed writer (SIGKILL, default SIGTERM, OOM) leaves the superblock marked "open for write",
-which plain HDF5 refuses ("use h5clear"); :func:`read_run` then opens it with ``swmr=True``
-(as it does runs still being written), after a time-boxed probe (:mod:`mpm_warp.io.opening`:
-an SWMR open of a damaged file would never return). SIGINT raises ``KeyboardInterrupt``
-between HDF5 calls and ``__exit__`` closes the file cleanly. :meth:`RunWriter.reopen` (resume)
-reads every kept frame once (a damaged one stops the resume) and copies them chunk by chunk
-(raw bytes, no recompression) into a rebuilt file that replaces the old one, so a kill during
-resume leaves the old file or the new one. Verified by killing a writer (strace
-fault injection) at every one of its ``pwrite`` calls.
-
-A kill can also land *inside* one ``pwrite``: Linux copies a write into the page cache page by
-page and stops between two pages for a fatal signal, so a rewrite in place of bytes spanning
-two pages can be left half new, half old, and fail its checksum for good. Files therefore use
-HDF5 paged aggregation with 4 KiB pages (:data:`~mpm_warp.io.hdf5.PAGE`; an object smaller
-than a page never straddles two), and the small series, whose last chunk is rewritten at every
-frame, get chunks of one page at most (:func:`~mpm_warp.io.hdf5.series_chunk`: 511 frames of
-``time``); particle frames are one chunk each, written once into new space. Measured (strace):
-up to about 8000 frames no rewrite in place spans two pages; beyond that HDF5 rewrites the
-7 KiB pages of the particle datasets' chunk index, and a kill inside one of those can still
-damage a file (the checkpoint, written aside and renamed, is not affected). Protected: death of
-the process. Not protected: power loss (no fsync per frame), network file systems (no SWMR
-write ordering).
+Crash safety (docs/robustness.md, "How files are kept safe")
+-------------------------------------------------------------
+Superblock v3, SWMR writes (HDF5 orders its metadata so that any prefix of the writes is a
+consistent file), 4 KiB paged aggregation, one chunk per particle frame; a frame is complete
+when every per-frame dataset holds its row (readers take ``min(lengths)``). A new or rebuilt
+file is written aside (``<path>.part``, its layout built in memory) and renamed over ``path``.
+Free space is checked before each frame; a write that finds no room raises
+:class:`~mpm_warp.io.space.OutOfSpace` and leaves the complete frames readable.
 """
 
 from __future__ import annotations
 
 import contextlib
-import json
 import os
-import uuid
 
 import h5py
 import numpy as np
@@ -66,7 +40,6 @@ from ..errors import InvalidArgument, OutputError
 from .hdf5 import (
     COMPRESSION,
     FORMAT,
-    FORMAT_VERSION,
     LIBVER,
     PAGE,
     RESERVED_ATTRS,
@@ -77,10 +50,9 @@ from .hdf5 import (
     now,
     open_read,
     pad_to_stored_eof,
-    series_chunk,
     series_datasets,
-    set_attrs,
 )
+from .layout import copy_chunks, skeleton
 from .opening import reading
 from .space import as_out_of_space, ensure_space, space_errno, write_image
 
@@ -226,7 +198,7 @@ class RunWriter:
         SWMR mode and move it over ``path``: a kill leaves the old file or the new one.
 
         Its layout (and the small series of the kept frames) is built in memory and written with
-        plain writes (:func:`_skeleton`), so a full disk there is one clean error; HDF5 itself then
+        plain writes (:func:`~mpm_warp.io.layout.skeleton`), so a full disk there is one clean error; HDF5 itself then
         writes only the kept particle frames, after a check that the space for them is free.
         """
         part = self.path + ".part"
@@ -235,11 +207,12 @@ class RunWriter:
                      "the run file" + (f" rebuilt with its {keep} frames" if src and keep else ""))
         f = None
         try:
-            write_image(part, self._skeleton(static, attrs, compression, src, keep))
+            write_image(part, skeleton(self.path, self.n_particles, self._fields, self._scalars, self.wall_names,
+                                        static, attrs, compression, src, keep))
             f = h5py.File(part, "r+", libver=LIBVER)
             if src and keep:
                 for name in self._fields:
-                    self._copy_chunks(src[f"particles/{name}"], f[f"particles/{name}"], keep)
+                    copy_chunks(self.path, src[f"particles/{name}"], f[f"particles/{name}"], keep, self._verify)
             f.swmr_mode = True                # flushes; from here on datasets only grow
             os.replace(part, self.path)
             return f
@@ -255,67 +228,6 @@ class RunWriter:
             if err is e:
                 raise
             raise err from None
-
-    def _skeleton(self, static, attrs, compression, src, keep) -> bytes:
-        """The new file's bytes, built in memory: every dataset (``keep`` frames long), the static fields and,
-        from ``src``, the kept frames of every series but the particle fields (:meth:`_copy_chunks` writes those)."""
-        f = h5py.File(f"{self.path}.skeleton-{uuid.uuid4().hex}", "w", driver="core", backing_store=False,
-                      libver=LIBVER, fs_strategy="page", fs_page_size=PAGE)
-        try:
-            f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, n_particles=self.n_particles,
-                           created=src.attrs["created"] if src else now())
-            versions = {"h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
-                        "numpy": np.__version__} | (attrs.get("versions") or {})
-            units = {"length": "m", "time": "s", "mass": "kg", "force": "N", "energy": "J"}
-            set_attrs(f, {**attrs, "versions": versions, "units": units | (attrs.get("units") or {})})
-            n, filt = self.n_particles, COMPRESSION[compression]
-
-            def series(name, dtype, unit, shape=(), chunk=None, **kw):
-                chunk = chunk or series_chunk(np.dtype(dtype).itemsize * int(np.prod(shape)))
-                d = f.create_dataset(name, shape=(keep, *shape), maxshape=(None, *shape), dtype=dtype,
-                                     chunks=(chunk, *shape), fletcher32=True, **kw)
-                d.attrs["unit"] = unit
-                if src and keep and not name.startswith("particles/"):
-                    with reading(self.path, f"{name}, in the {keep} frames the resume keeps"):
-                        for i in range(0, keep, chunk):
-                            d[i:i + chunk] = src[name][i:min(i + chunk, keep)]
-                return d
-
-            series("time", "f8", "s")
-            series("step", "i8", "1")
-            f.create_group("particles", track_order=True)
-            for name, (shape, dtype, unit) in self._fields.items():
-                series(f"particles/{name}", dtype, unit, (n, *shape), chunk=1, **filt)
-            f.create_group("static", track_order=True)
-            for name, (array, unit) in static.items():
-                f.create_dataset(f"static/{name}", data=array, fletcher32=True, **filt).attrs["unit"] = unit
-            f.create_group("scalars", track_order=True)
-            for name, unit in self._scalars.items():
-                series(f"scalars/{name}", "f8", unit)
-            if self.wall_names:
-                series("walls/forces", "f8", "N", (len(self.wall_names), 3)).attrs["names"] = \
-                    json.dumps(self.wall_names)
-            f.flush()
-            return f.id.get_file_image()
-        finally:
-            f.close()
-
-    def _copy_chunks(self, s: h5py.Dataset, d: h5py.Dataset, keep: int) -> None:
-        """The first ``keep`` frames of particle dataset ``s`` into ``d`` (same layout: raw compressed chunks, each
-        read once first when :attr:`_verify`, so that its checksum is checked)."""
-        with reading(self.path, f"{s.name.lstrip('/')}, in the {keep} frames the resume keeps"):
-            if s.chunks == d.chunks and (s.compression, s.shuffle, s.fletcher32) == \
-                    (d.compression, d.shuffle, d.fletcher32):
-                for i in range(s.id.get_num_chunks()):
-                    info = s.id.get_chunk_info(i)
-                    if info.chunk_offset[0] < keep:
-                        if self._verify:
-                            s[info.chunk_offset[0]]          # decompress: the checksum is checked
-                        raw = s.id.read_direct_chunk(info.chunk_offset)[1]
-                        d.id.write_direct_chunk(info.chunk_offset, raw, info.filter_mask)
-            else:
-                for i in range(keep):
-                    d[i] = s[i]
 
     @property
     def n_frames(self) -> int:
