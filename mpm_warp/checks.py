@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import typing
 from collections.abc import Sequence
 
@@ -68,3 +69,28 @@ def check_choices(obj, where: str) -> None:
             choice(f"{where}.{f.name}", value, typing.get_args(hints[f.name]))
         elif dataclasses.is_dataclass(value) and not isinstance(value, type):
             check_choices(value, f"{where}.{f.name}")
+
+
+def flag(field: str, value) -> bool:
+    """Check a bool (``overwrite="no"`` is not a yes: any other type is refused)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidArgument(field, value, "True or False")
+    return bool(value)
+
+
+def file_path(field: str, value, *, none: bool = False) -> str | None:
+    """Check a file path (``str`` or ``os.PathLike``, not empty); None too when ``none``. Returns a ``str``."""
+    if value is None and none:
+        return None
+    if isinstance(value, os.PathLike):
+        value = os.fspath(value)
+    if not isinstance(value, str) or not value:
+        raise InvalidArgument(field, value, "a file path (str or os.PathLike)" + (" or None" if none else ""))
+    return value
+
+
+def optional_callable(field: str, value):
+    """Check None or a callable."""
+    if value is not None and not callable(value):
+        raise InvalidArgument(field, value, "None or a callable")
+    return value

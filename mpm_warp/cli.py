@@ -20,71 +20,9 @@ import sys
 import time
 
 from .errors import MPMError, SimulationBlowUp
+from .stop import Interrupted, StopRequest  # noqa: F401 (Interrupted: part of the CLI's interface)
 
 __all__ = ["main"]
-
-
-class StopRequest:
-    """SIGINT/SIGTERM handler: stop the run with a checkpoint, never an unbounded wait.
-
-    Python may swallow a KeyboardInterrupt raised inside a callback, so the CLI catches the
-    signals itself. A first signal lets the current frame finish when it is due within
-    :attr:`far_s` seconds of wall time (judged from the last frame's duration); otherwise, and
-    on a second signal, the simulation stops after its current batch of steps
-    (:meth:`mpm_warp.Simulation.request_stop`) with a checkpoint that resumes exactly. A third
-    signal aborts at once (complete frames are kept).
-    """
-
-    def __init__(self, far_s: float = 2.0):
-        self.far_s = far_s
-        self.requested = False
-        self.signals = 0
-        self.sim = None
-        self._now = False
-        self._frame_start = time.perf_counter()
-        self._frame_wall = None
-        self._old = {}
-
-    def __enter__(self):
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            self._old[sig] = signal.signal(sig, self._handle)
-        return self
-
-    def __exit__(self, *exc):
-        for sig, old in self._old.items():
-            signal.signal(sig, old)
-
-    def attach(self, sim) -> None:
-        """The simulation to stop (a stop asked for before it existed applies now)."""
-        self.sim = sim
-        self._frame_start = time.perf_counter()
-        if self._now:
-            sim.request_stop()
-
-    def frame_done(self) -> None:
-        now = time.perf_counter()
-        self._frame_wall, self._frame_start = now - self._frame_start, now
-
-    def frame_due_in(self) -> float:
-        """Wall seconds until the current frame is expected to end (inf before a first frame)."""
-        if self._frame_wall is None:
-            return math.inf
-        return max(0.0, self._frame_wall - (time.perf_counter() - self._frame_start))
-
-    def _handle(self, signum, frame):
-        self.signals += 1
-        if self.signals >= 3:
-            raise KeyboardInterrupt
-        self.requested = True
-        if self.signals == 1 and self.frame_due_in() <= self.far_s:
-            sys.stderr.write("\nmpm-warp: stop requested; finishing the current frame (signal again to stop "
-                             "sooner)\n")
-            return
-        self._now = True
-        if self.sim is not None:
-            self.sim.request_stop()
-        sys.stderr.write("\nmpm-warp: stop requested; stopping after the current batch of steps with a checkpoint "
-                         "(signal again to abort at once)\n")
 
 
 class Progress:
@@ -375,7 +313,7 @@ def build_parser() -> argparse.ArgumentParser:
     rs = sub.add_parser("resume", help="continue a run from its last checkpoint")
     rs.add_argument("run", help="the run's HDF5 file (its checkpoint RUN.ckpt.h5 must sit beside it)")
     rs.add_argument("--device", default=None)
-    rs.add_argument("--end", type=float, default=None, help="new end time (s), not before the checkpoint's")
+    rs.add_argument("--end", type=float, default=None, help="new end time (s), after the run file's last frame")
     rs.add_argument("--max-memory", default=None, metavar="SIZE", help="as for run")
     rs.add_argument("--quiet", action="store_true", help="no progress bar")
     rs.set_defaults(func=cmd_resume)
@@ -414,9 +352,11 @@ def main(argv=None) -> int:
     except OSError as e:                 # a file system refusing something the checks could not foresee
         print(f"mpm-warp: error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("mpm-warp: interrupted; complete frames are kept in the output file", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as e:
+        signum = getattr(e, "signum", signal.SIGINT)
+        print(f"mpm-warp: interrupted ({signal.Signals(signum).name}); complete frames are kept in the output file",
+              file=sys.stderr)
+        return 128 + signum
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -11,7 +11,6 @@ the field, the value and the allowed range). Reading TOML files, overrides and s
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal, Protocol, get_args, runtime_checkable
 
@@ -20,10 +19,12 @@ import numpy as np
 from .checks import choice, finite_number, positive_int, vector
 from .errors import InvalidArgument
 from .materials import Elastic
+from .time_step import MAX_MACH, MAX_STEPS, STABLE_DT, check_end_time, first_step, step_budget
 from .walls import WALL_KINDS, WallKind
 
 __all__ = ["Block", "Domain", "TimeControl", "Output", "Scenario", "SceneParams", "OUTPUT_FIELDS", "PRECISIONS",
-           "BOUNDARIES", "Precision", "Boundary", "ON_INVERSION", "MAX_STEPS", "MAX_MACH"]
+           "BOUNDARIES", "Precision", "Boundary", "ON_INVERSION", "MAX_STEPS", "MAX_MACH", "STABLE_DT", "first_step",
+           "check_end_time"]
 
 Precision = Literal["float32", "float64"]
 PRECISIONS: tuple[str, ...] = get_args(Precision)
@@ -33,11 +34,6 @@ BOUNDARIES: tuple[str, ...] = (*WALL_KINDS, "none")
 OnInversion = Literal["report", "stop"]
 #: what a run does when P2G floors singular values or meets an inverted element (``Output.on_inversion``)
 ON_INVERSION: tuple[str, ...] = get_args(OnInversion)
-#: most steps a run may need (its first step size times this reaches time.end): far beyond any snow experiment
-#: (a PST of 1 s at dx = 2 mm takes ~1e6), so more means a typo in a modulus, a density, a speed or a time
-MAX_STEPS = 1.0e8
-#: fastest initial speed, in multiples of the fastest P-wave speed of the materials (snow: 70-300 m/s)
-MAX_MACH = 100.0
 #: particle fields the output may hold: name -> (per-particle shape, unit, description); "dim" is the scene's dimension
 OUTPUT_FIELDS = {
     "x": (("dim",), "m", "position"),
@@ -151,6 +147,9 @@ class TimeControl:
         Fixed step (s); 0 selects the automatic step.
     dt_max : float
         Upper bound of the automatic step (s); 0 means none.
+    allow_unstable_dt : bool
+        Accept a fixed ``dt`` above the stability limit :data:`STABLE_DT` ``dx / c_p`` (stability studies:
+        the health check then stops the run); False (default) refuses it before anything runs.
     gravity : (dim,) float or None
         Gravitational acceleration (m/s^2); a slope is a rotated gravity. None: 9.81 m/s^2 along -y.
     gravity_ramp : float
@@ -167,6 +166,7 @@ class TimeControl:
     cfl: float = 0.4
     dt: float = 0.0
     dt_max: float = 0.0
+    allow_unstable_dt: bool = False
     gravity: tuple | None = None
     gravity_ramp: float = 0.0
     damping: float = 0.0
@@ -264,7 +264,7 @@ class Scenario:
         if self.scene is not None and not isinstance(self.scene, SceneParams):
             raise InvalidArgument("scene", self.scene, "typed scene parameters (e.g. mpm_warp.scenes.pst.PSTParams) "
                                   "or None; a scenario file's [scene] table is read by mpm_warp.loader")
-        _step_budget(tc, dom.dx, mats, blocks)
+        step_budget(tc, dom.dx, mats, blocks)
         return replace(self, domain=dom, time=tc, materials=mats, blocks=blocks, walls=walls, output=outp)
 
     def to_dict(self) -> dict:
@@ -326,6 +326,7 @@ def _time(t: TimeControl, dim: int) -> TimeControl:
         cfl=finite_number("time.cfl", t.cfl, lo=0.0, hi=1.0, lo_open=True),
         dt=finite_number("time.dt", t.dt, lo=0.0),
         dt_max=finite_number("time.dt_max", t.dt_max, lo=0.0),
+        allow_unstable_dt=_flag("time.allow_unstable_dt", t.allow_unstable_dt),
         gravity=vector("time.gravity", (0.0, -9.81, 0.0)[:dim] if t.gravity is None else t.gravity, dim),
         gravity_ramp=finite_number("time.gravity_ramp", t.gravity_ramp, lo=0.0),
         damping=finite_number("time.damping", t.damping, lo=0.0),
@@ -363,36 +364,7 @@ def _block(b: Block, i: int, mats: dict, dom: Domain) -> Block:
     return Block(b.material, blo, bhi, vel, ppc, b.name or f"block{i}", hs)
 
 
-def _step_budget(tc: TimeControl, dx: float, mats: dict, blocks) -> None:
-    """Refuse speeds, moduli and densities that would make a run take more than :data:`MAX_STEPS` steps.
-
-    The first step is ``dt = cfl dx / (c_p + |v|)`` (``time.dt`` if fixed, capped by ``time.dt_max``)
-    with ``c_p`` the fastest P-wave speed and ``|v|`` the fastest constant initial speed (a Python
-    velocity function is not evaluated here); an initial speed above :data:`MAX_MACH` ``c_p`` is
-    refused on its own.
-    """
-    name, fastest = max(((k, m) for k, m in mats.items() if any(b.material == k for b in blocks)),
-                        key=lambda km: km[1].p_wave_speed)
-    c_p = fastest.p_wave_speed
-    for i, b in enumerate(blocks):
-        if callable(b.velocity):
-            continue
-        speed = math.sqrt(sum(c * c for c in b.velocity))
-        if speed > MAX_MACH * c_p:
-            raise InvalidArgument(f"blocks[{i}].velocity", b.velocity, (
-                f"a speed at most {MAX_MACH:g} times the fastest P-wave speed, {MAX_MACH * c_p:.3g} m/s "
-                f"(c_p = {c_p:.3g} m/s of materials.{name}); |v| = {speed:.3g} m/s is Mach {speed / c_p:.3g}"))
-    vmax = max((math.sqrt(sum(c * c for c in b.velocity)) for b in blocks if not callable(b.velocity)), default=0.0)
-    if tc.dt > 0:
-        dt, field, value, why = tc.dt, "time.dt", tc.dt, "the fixed step"
-    else:
-        dt = tc.cfl * dx / (c_p + vmax)
-        field, value = f"materials.{name} (E, density)", (fastest.E, fastest.density)
-        why = (f"dt = cfl dx / (c_p + |v|) = {tc.cfl:g} x {dx:g} m / ({c_p:.3g} + {vmax:.3g} m/s) with c_p = "
-               f"{c_p:.3g} m/s of materials.{name}")
-    if tc.dt_max > 0 and tc.dt_max < dt:
-        dt, field, value, why = tc.dt_max, "time.dt_max", tc.dt_max, "the step cap time.dt_max"
-    steps = tc.end / dt
-    if steps > MAX_STEPS:
-        raise InvalidArgument(field, value, f"values giving at most {MAX_STEPS:.0e} steps to time.end = {tc.end:g} s: "
-                              f"{why} makes dt = {dt:.3g} s and {steps:.3g} steps")
+def _flag(field: str, value) -> bool:
+    if not isinstance(value, bool):
+        raise InvalidArgument(field, value, "true or false")
+    return value

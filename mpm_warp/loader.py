@@ -20,6 +20,7 @@ import dataclasses
 import difflib
 import math
 import os
+import stat
 import typing
 from importlib.resources import files
 
@@ -219,10 +220,22 @@ def apply_overrides(raw: dict, overrides: list[str] | dict) -> dict:
     """Apply ``section.key=value`` overrides to a raw scenario dict (a copy).
 
     Values are parsed as TOML literals (``1e6``, ``[0, -9.81, 0]``, ``"slip"``); a bare word is
-    taken as a string. ``blocks.0.material=snow`` indexes arrays.
+    taken as a string. ``blocks.0.material=snow`` indexes arrays. ``overrides`` is a list (or tuple)
+    of ``"key=value"`` strings, a dict ``{key: value}``, or one ``"key=value"`` string.
     """
     raw = copy.deepcopy(raw)
-    items = overrides.items() if isinstance(overrides, dict) else [split_override(o) for o in overrides]
+    if isinstance(overrides, str):
+        overrides = [overrides]
+    if isinstance(overrides, dict):
+        bad = [k for k in overrides if not isinstance(k, str)]
+        if bad:
+            raise InvalidArgument("overrides", overrides, f"a dict with 'section.key' strings as keys, not {bad[0]!r}")
+        items = overrides.items()
+    elif isinstance(overrides, (list, tuple)):
+        items = [split_override(o) for o in overrides]
+    else:
+        raise InvalidArgument("overrides", overrides, "a list of 'section.key=value' strings, a dict "
+                              "{'section.key': value} or one 'section.key=value' string")
     for key, value in items:
         if isinstance(value, str):
             try:
@@ -272,9 +285,22 @@ def list_scenes() -> list[str]:
 
 
 def scenario_path(path_or_name) -> str:
-    """The TOML file of a scenario path or of a ready scene's name; :class:`ScenarioError` when neither exists."""
-    path = os.fspath(path_or_name)
+    """The TOML file of a scenario path or of a ready scene's name; :class:`ScenarioError` when neither exists.
+
+    A path that is not a regular file or a folder (a FIFO, a device, a socket) is refused here, before
+    anything opens it (opening a FIFO without a writer would wait for ever).
+    """
+    if isinstance(path_or_name, os.PathLike):
+        path_or_name = os.fspath(path_or_name)
+    if not isinstance(path_or_name, str) or not path_or_name:
+        raise InvalidArgument("scenario", path_or_name, "a Scenario, a scenario file path (str or os.PathLike) or "
+                              "the name of a ready scene (mpm-warp scenes)")
+    path = path_or_name
     if os.path.exists(path):
+        mode = os.stat(path).st_mode
+        if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+            raise ScenarioError(f"{path}: is not a regular file (a FIFO, a device or a socket): a scenario is read "
+                                "from a TOML file")
         return path
     fname = path if path.endswith(".toml") else path + ".toml"
     cand = os.path.join(scenarios_dir(), fname)

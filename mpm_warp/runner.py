@@ -14,13 +14,15 @@ import contextlib
 import os
 from collections.abc import Callable
 
-from . import io
-from .config import Scenario
-from .errors import InvalidArgument
+from . import checks, io
+from .config import Scenario, check_end_time
+from .errors import InvalidArgument, OutputError
+from .io.hdf5 import pad_to_stored_eof
 from .loader import load_scenario, resolved_scenario, scenario_path
 from .result import RunResult
 from .scenes import attach
 from .simulation import Simulation
+from .snapshot import check_identity
 
 __all__ = ["run", "resume", "simulation_for", "claimed_output"]
 
@@ -79,13 +81,19 @@ def run(scenario, output: str | None = None, device: str | None = None, override
     RunResult
         With ``scene_result`` (e.g. a PST's crack speed) and ``monitor`` (the scene's series).
     """
+    overwrite = checks.flag("overwrite", overwrite)
+    output = checks.file_path("output", output, none=True)
+    on_start = checks.optional_callable("on_start", on_start)
+    unknown = sorted(run_kwargs.keys() - {"end_time", "frame_interval", "callback"})
+    if unknown:
+        raise InvalidArgument("run_kwargs", unknown, "only end_time, frame_interval and callback (of Simulation.run)")
     if isinstance(scenario, Scenario):
         if overrides:
             raise InvalidArgument("overrides", overrides, "None with a Scenario object (use dataclasses.replace)")
         inputs = ()
     else:
-        scenario = os.fspath(scenario)
         inputs = (scenario_path(scenario),)
+        scenario = os.fspath(scenario)
     with claimed_output(output, overwrite=overwrite, inputs=inputs) as output:
         if not isinstance(scenario, Scenario):
             scenario = load_scenario(scenario, overrides)
@@ -95,25 +103,49 @@ def run(scenario, output: str | None = None, device: str | None = None, override
         return sim.run(output, overwrite=overwrite, **run_kwargs)
 
 
+def _every_frame_reads(path: str) -> None:
+    run = io.read_run(path)
+    for i in range(run.n_frames):
+        run.frame(i)
+
+
 def resume(output, device: str | None = None, end_time: float | None = None, callback=None,
            n_threads: int | None = None, max_memory=None,
            on_start: Callable[[Simulation], None] | None = None) -> RunResult:
     """Continue the run stored in ``output`` from its last checkpoint, monitors included.
 
-    The checkpoint is verified (SHA-256) and the run file's kept frames are read once (a damaged
-    one stops the resume); the file is then truncated to the checkpoint's frame and extended. On
-    the CPU a resumed run matches an uninterrupted one bit for bit (positions, ``log_jp``, the
-    monitors' series and result), also from a checkpoint written mid-frame by
-    :meth:`Simulation.request_stop`. ``end_time`` before the checkpoint's time is refused.
+    The checkpoint must be of this run file (the ``run_id`` both hold:
+    :func:`mpm_warp.snapshot.check_identity`) and is verified (SHA-256); the run file's frames are
+    read once (a damaged one stops the resume) and all kept: those written after the checkpoint are
+    stepped over again, not rewritten. On the CPU a resumed run matches an uninterrupted one bit for
+    bit (positions, ``log_jp``, the monitors' series and result), also from a checkpoint written
+    mid-frame by :meth:`Simulation.request_stop`.
+
+    ``end_time`` (default the scenario's ``time.end``) is checked as ``time.end`` is (finite, > 0, the
+    step budget) and must lie after the run file's last frame: a resume never removes frames.
     """
+    output = checks.file_path("output", output)
+    callback = checks.optional_callable("callback", callback)
+    on_start = checks.optional_callable("on_start", on_start)
     with claimed_output(output, append=True) as output:
-        meta = io.read_checkpoint_meta(io.checkpoint_path_for(output))
-        sim = simulation_for(resolved_scenario(meta["scenario"], source=output), device, n_threads,
-                             max_memory=max_memory)
+        with contextlib.suppress(OSError):     # a run that found no room may have left its file short of its end
+            pad_to_stored_eof(output, _every_frame_reads)
+        ckpt = io.checkpoint_path_for(output)
+        if not os.path.exists(ckpt):
+            raise OutputError(f"{output}: has no checkpoint {ckpt} to resume from")
+        meta = io.read_checkpoint_meta(ckpt)
+        run = io.read_run(output)
+        check_identity(output, ckpt, run.attrs, meta)
+        scenario = resolved_scenario(meta["scenario"], source=output)
+        end = scenario.time.end if end_time is None else check_end_time(scenario, end_time)
+        last = float(run.times[-1])
+        if end <= last * (1 + 1e-12):
+            raise InvalidArgument("end_time", end_time if end_time is not None else end, (
+                f"a time after the last frame's t = {last:.6g} s: {output} holds {run.n_frames} frames to there "
+                "and a resume never removes frames" + (" (give a later end time to extend it)"
+                                                       if end >= last * (1 - 1e-12) else "")))
+        sim = simulation_for(scenario, device, n_threads, max_memory=max_memory)
         sim.restore(output)
-        if end_time is not None and end_time < sim.time * (1 - 1e-12):
-            raise InvalidArgument("end_time", end_time, f"a time after the checkpoint's t = {sim.time:.6g} s, from "
-                                  "which the run continues")
         if on_start is not None:
             on_start(sim)
-        return sim.run(output, end_time=end_time, callback=callback, append=True)
+        return sim.run(output, end_time=end, callback=callback, append=True)

@@ -7,6 +7,7 @@ flags, a few bytes) and at frames (output fields).
 
 from __future__ import annotations
 
+import logging
 import math
 import time as _time
 from collections.abc import Callable
@@ -14,16 +15,17 @@ from collections.abc import Callable
 import numpy as np
 import warp as wp
 
-from . import io, snapshot
-from .config import OUTPUT_FIELDS, Scenario
+from . import checks, frames, io, snapshot
+from .config import Scenario
 from .device import resolve_device
-from .errors import InvalidArgument, SimulationBlowUp
+from .errors import InvalidArgument, MPMError, SimulationBlowUp
 from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, health_zz_kernel, stress_kernel
 from .memory import check_memory
 from .model import Model, ParticleGroup, State, material_params
 from .monitor import GroupState, Monitor
-from .result import RunResult, versions
+from .result import RunResult
 from .step import Stepper
+from .time_step import run_times
 
 __all__ = ["Simulation"]
 
@@ -60,6 +62,14 @@ class Simulation:
 
     def __init__(self, scenario: Scenario, device: str | None = None, use_graph: bool | None = None,
                  n_threads: int | None = None, max_memory=None):
+        if not isinstance(scenario, Scenario):
+            raise InvalidArgument("scenario", scenario if isinstance(scenario, str) else type(scenario).__name__,
+                                  "a Scenario (mpm_warp.load_scenario(file or scene name); mpm_warp.run takes "
+                                  "names and files directly)")
+        if use_graph is not None:
+            checks.flag("use_graph", use_graph)
+        if n_threads is not None:
+            checks.positive_int("n_threads", n_threads, lo=1, hi=1024)
         self.scenario = scenario.validate()
         self.device = resolve_device(device)
         #: the memory estimate, checked before anything is allocated
@@ -77,6 +87,8 @@ class Simulation:
         self._energy = wp.zeros(2, dtype=wp.float64, device=self.device)
         self._no_log_jp = wp.zeros(0, dtype=self.model.T, device=self.device)  # elastic groups: no plastic volume
         self._stop_now = False
+        #: identity of the run file this simulation writes (:func:`mpm_warp.frames.new_run_id`), in its checkpoints
+        self.run_id: str | None = None
 
     # ----------------------------------------------------------------- public
     @property
@@ -169,49 +181,19 @@ class Simulation:
         return p, q
 
     def particle_field(self, name: str) -> np.ndarray:
-        """Host copy of one output field for all particles (see ``OUTPUT_FIELDS``)."""
-        s = self.state
-        n = self.model.n_particles
-        if name in ("x", "v"):
-            return getattr(s, name).numpy()
-        if name == "F":
-            return s.elastic_deformation_gradient().astype(self.model.np_dtype)
-        if name == "stress":
-            return self.stresses(cauchy=True)[2]
-        if name in ("log_jp", "kappa"):
-            out = np.zeros(n, dtype=self.model.np_dtype)
-            arr = getattr(s, name)
-            if arr is not None:
-                a = arr.numpy()
-                for g in self.model.groups:
-                    at = g.plastic_start if name == "log_jp" else g.kappa_start
-                    if at >= 0:
-                        out[g.start:g.end] = a[at:at + g.count]
-            return out
-        if name == "damage":
-            out = np.zeros(n, dtype=self.model.np_dtype)
-            if s.kappa is not None:
-                a = s.kappa.numpy().astype(np.float64)
-                for g in self.model.groups:
-                    k = a[g.kappa_start:g.kappa_start + g.count] if g.kappa_start >= 0 else None
-                    if g.material.model == "tensile_cracking":
-                        out[g.start:g.end] = g.material.damage(k)
-                    elif g.material.model == "bonded_camclay":
-                        out[g.start:g.end] = np.minimum(1.0, k / g.material.kappa_s)
-            return out
-        if name in ("p", "q"):
-            p, q = self.stress_invariants()
-            return p if name == "p" else q
-        if name == "yielded":
-            out = np.zeros(n, dtype=np.uint8)
-            if s.yielded is not None:
-                y = s.yielded.numpy()
-                for g in self.model.groups:
-                    if g.plastic_start >= 0:
-                        out[g.start:g.end] = y[g.plastic_start:g.plastic_start + g.count]
-                s.yielded.zero_()
-            return out
-        raise InvalidArgument("field", name, "one of " + ", ".join(OUTPUT_FIELDS))
+        """Host copy of one output field for all particles (:func:`mpm_warp.frames.particle_field`)."""
+        return frames.particle_field(self, name)
+
+    def _store_outcome(self, writer) -> None:
+        """The monitors' ``outcome()`` records into the run file's ``outcome`` attribute (a failure there is logged:
+        the frames are safe and the result carries the outcome too)."""
+        outcomes = {n: m.outcome() for n, m in self.monitors.items() if callable(getattr(m, "outcome", None))}
+        if not outcomes or getattr(writer, "_failed", False):
+            return
+        try:
+            writer.set_outcome(outcomes)
+        except (OSError, MPMError) as e:
+            logging.getLogger("mpm_warp").warning(f"{writer.path}: the outcome attribute was not stored ({e})")
 
     def health(self) -> None:
         """Run the device health check; raise SimulationBlowUp on failure."""
@@ -249,6 +231,7 @@ class Simulation:
         Steps run in batches sized from the current step size; between batches
         the host reads the clock and (every ``health_every`` steps) the health flags.
         """
+        t_end = checks.finite_number("t_end", t_end, lo=0.0)
         he = health_every or self.scenario.output.health_every
         self.stepper.set_frame_end(t_end)
         t, dt, steps0 = self.stepper.clock()
@@ -291,56 +274,70 @@ class Simulation:
 
         Parameters
         ----------
-        output : str or None
+        output : str, os.PathLike or None
             HDF5 path; None runs without output. It is checked (:func:`mpm_warp.io.check_output_file`) and
             locked (:func:`mpm_warp.io.output_lock`) before anything else.
         end_time, frame_interval : float or None
-            Override the scenario's ``time.end`` / ``time.frame_interval`` (s).
+            Override the scenario's ``time.end`` / ``time.frame_interval`` (s); checked as they are (finite,
+            > 0, at most :data:`~mpm_warp.config.MAX_STEPS` steps; a frame interval at most the end time).
         callback : callable or None
             ``callback(sim, frame)`` after every frame; returning False stops the run.
         append : bool
-            Continue an existing output (used by :func:`resume`).
+            Continue an existing output (used by :func:`resume`): its frames are all kept, those after
+            the checkpoint are stepped over again without being rewritten.
         overwrite : bool
             Replace an existing ``output`` (a regular file only).
 
-        Returns
-        -------
-        RunResult
+        A second call continues from where the first stopped (``end_time`` beyond it) without output;
+        with one it is refused (a run file starts at the initial state; :func:`~mpm_warp.resume` it).
         """
+        output = checks.file_path("output", output, none=True)
+        end, fi = run_times(self.scenario, end_time, frame_interval)
+        callback = checks.optional_callable("callback", callback)
+        append, overwrite = checks.flag("append", append), checks.flag("overwrite", overwrite)
+        if not append and self.time > 0.0:
+            if output is not None:
+                raise InvalidArgument("output", output, f"None: this Simulation has run to t = {self.time:.6g} s "
+                                      "already, and a run file starts at the initial state (make a new Simulation, "
+                                      "or mpm_warp.resume the file it wrote)")
+            if end <= self.time * (1 + 1e-12):
+                raise InvalidArgument("end_time", end_time, f"a time after t = {self.time:.6g} s, where this "
+                                      "Simulation stopped (a second run continues from there)")
         if output is None:
-            return self._run(None, end_time, frame_interval, callback, append)
+            return self._run(None, end, fi, callback, append)
         output = io.check_output_file(output, overwrite=overwrite, append=append)
         with io.output_lock(output):
-            return self._run(output, end_time, frame_interval, callback, append)
+            try:
+                return self._run(output, end, fi, callback, append)
+            except io.OutOfSpace as e:   # the complete frames and the checkpoint say how to go on
+                raise frames.out_of_space(e, output) from None
 
-    def _run(self, output, end_time, frame_interval, callback, append) -> RunResult:
-        tc = self.scenario.time
-        end = tc.end if end_time is None else end_time
-        fi = tc.frame_interval if frame_interval is None else frame_interval
+    def _run(self, output, end, fi, callback, append) -> RunResult:
         writer = None
         ckpt = io.checkpoint_path_for(output) if output else None
         n_frames_total = int(math.ceil(end / fi - 1e-9))
         if output:
             if append:
-                # restore() read every kept frame already
-                writer = io.RunWriter.reopen(output, keep_frames=self.frame_index + 1, verify=False)
+                # every frame is kept (restore() read them all): those after the checkpoint are stepped over
+                writer = io.RunWriter.reopen(output, verify=False)
             else:
-                writer = self._open_writer(output)
-                self._write_frame(writer)
-                self._checkpoint(ckpt)
+                self.run_id = frames.new_run_id()
+                writer = frames.open_writer(self, output)
         elif not append:
-            self._frame_diagnostics()
+            frames.frame_diagnostics(self)
         if not append:
             self._last_frame_time = self.time
-        # warm up: compile every kernel before timing
-        self._compile()
         steps_total = 0
-        frames = 0
+        n_done = 0
         wall = 0.0
         edge0 = self.stepper.edge_count()[0]
         events0 = self.stepper.deformation_events()
         stopped = False
         try:
+            if writer is not None and not append:
+                frames.write_frame(self, writer)
+                self._checkpoint(ckpt)
+            self._compile()   # warm up: compile every kernel before timing
             while self.frame_index < n_frames_total:
                 t_next = min((self.frame_index + 1) * fi, end)
                 t0 = _time.perf_counter()
@@ -353,16 +350,19 @@ class Simulation:
                     stopped = True
                     break
                 self.frame_index += 1
-                frames += 1
+                n_done += 1
                 self.health()  # never write a bad state into a frame or a checkpoint
                 self._since_health = 0
                 if writer is not None:
-                    self._write_frame(writer)
+                    if self.frame_index < writer.n_frames:   # on file already (after the checkpoint): kept
+                        frames.frame_record(self)
+                    else:
+                        frames.write_frame(self, writer)
                     ce = self.scenario.output.checkpoint_every
                     if ce and self.frame_index % ce == 0:
                         self._checkpoint(ckpt)
                 else:
-                    self._frame_diagnostics()
+                    frames.frame_diagnostics(self)
                 if (callback is not None and callback(self, self.frame_index) is False) or self._stop_now:
                     if writer is not None:
                         self._checkpoint(ckpt)  # a stop on request can be resumed from exactly here
@@ -377,10 +377,7 @@ class Simulation:
             self._stop_now = False
             if writer is not None:
                 try:
-                    outcomes = {n: m.outcome() for n, m in self.monitors.items()
-                                if callable(getattr(m, "outcome", None))}
-                    if outcomes:
-                        writer.set_outcome(outcomes)
+                    self._store_outcome(writer)
                 finally:
                     writer.close()
         n = self.model.n_particles
@@ -388,7 +385,7 @@ class Simulation:
         for m in self.monitors.values():
             result.update(m.result())
         floors, inversions = (a - b for a, b in zip(self.stepper.deformation_events(), events0, strict=True))
-        return RunResult(output, steps_total, frames, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
+        return RunResult(output, steps_total, n_done, self.time, wall, n * steps_total / wall if wall > 0 else 0.0,
                          n, self.device, self.stepper.edge_count()[0] - edge0, result, dict(self.monitors),
                          floors, inversions, stopped)
 
@@ -397,60 +394,7 @@ class Simulation:
         for m in {k.kernel.module for k in self.stepper.launches}:
             m.load(wp.get_device(self.device))
 
-    # ----------------------------------------------------------------- output
-    def _open_writer(self, path: str) -> io.RunWriter:
-        pf = {}
-        for name in self.scenario.output.fields:
-            shape, unit, _ = OUTPUT_FIELDS[name]
-            shape = tuple(self.model.dim if c == "dim" else c for c in shape)
-            dt = "uint8" if name == "yielded" else self.scenario.precision
-            pf[name] = (shape, dt, unit)
-        for m in self.monitors.values():
-            for name, (shape, unit) in getattr(m, "particle_fields", dict)().items():
-                pf[name] = (shape, self.scenario.precision, unit)
-        group_id = np.zeros(self.model.n_particles, dtype=np.uint8)
-        for i, g in enumerate(self.model.groups):
-            group_id[g.start:g.end] = i
-        static = {"x0": (self.x0.astype(self.model.np_dtype), "m"), "group": (group_id, "1")}
-        scalars = {"kinetic_energy": "J", "elastic_energy": "J"}
-        for m in self.monitors.values():
-            scalars.update(m.units())
-        attrs = {
-            "scenario": self.scenario.to_dict(),
-            "versions": versions(),
-            "device": self.device,
-            "precision": self.scenario.precision,
-            "groups": [{"name": g.name, "material": g.material_name, "start": g.start, "end": g.end,
-                        "mass": g.mass, "vol0": g.vol0} for g in self.model.groups],
-            "unit_system": "SI: m, s, kg, Pa, N, J",
-            "grid": {"origin": list(self.model.origin), "shape": list(self.model.grid_shape), "dx": self.model.dx},
-        }
-        return io.RunWriter(path, n_particles=self.model.n_particles, particle_fields=pf, static_fields=static,
-                            wall_names=self.model.wall_names, scalar_series=scalars, attrs=attrs)
-
-    def _write_frame(self, writer: io.RunWriter) -> None:
-        t, _, steps = self.stepper.clock()
-        parts = {name: self.particle_field(name) for name in self.scenario.output.fields}
-        for m in self.monitors.values():
-            parts.update({name: m.particle_field(name) for name in getattr(m, "particle_fields", dict)()})
-        scalars = self.energies()
-        scalars.update(self._frame_diagnostics())
-        imp = self.stepper.take_wall_impulse()
-        # mean force over the frame just ended (its real duration: the last frame may be short)
-        span = t - getattr(self, "_last_frame_time", t)
-        self._last_frame_time = t
-        forces = (imp / span if span > 0 else np.zeros_like(imp)) if len(imp) else None
-        if forces is not None and forces.shape[1] < 3:  # plane strain: N per metre of depth, z component 0
-            forces = np.pad(forces, ((0, 0), (0, 3 - forces.shape[1])))
-        writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
-
-    def _frame_diagnostics(self) -> dict:
-        """The monitors' frame scalars (also without an output file: they may record series)."""
-        out = {}
-        for m in self.monitors.values():
-            out.update(m.frame_scalars(self))
-        return out
-
+    # ----------------------------------------------------------------- state
     def snapshot(self) -> tuple[dict[str, np.ndarray], dict]:
         """The whole state of the run in memory (:func:`mpm_warp.snapshot.take_snapshot`): what a checkpoint holds."""
         return snapshot.take_snapshot(self)

@@ -39,6 +39,7 @@ import itertools
 import json
 import os
 import re
+import stat
 import sys
 import time
 import traceback
@@ -103,11 +104,36 @@ def parse_vary(items) -> dict:
 
 
 def read_cases(path) -> list[dict]:
-    """Cases from a CSV file: a header of override keys, one case per row; an empty cell is no override."""
-    with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    cases = [{k.strip(): v.strip() for k, v in r.items() if k and v is not None and v.strip()} for r in rows]
-    return [c for c in cases if c]
+    """Cases from a CSV file: a header of override keys, one case per row; an empty cell is no override.
+
+    The file must be a regular UTF-8 file with a header of distinct, non-empty keys, at least one case
+    and, in every row, one value per column (blank lines are skipped); otherwise
+    :class:`InvalidArgument` names the row.
+    """
+    path = os.fspath(path)
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            raise InvalidArgument("cases", path, "a regular CSV file (not a folder, FIFO, device or socket)")
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = [(i, r) for i, r in enumerate(csv.reader(fh), start=1) if any(c.strip() for c in r)]
+    except UnicodeDecodeError as e:
+        raise InvalidArgument("cases", path, f"a UTF-8 CSV file (byte {e.start} is not UTF-8)") from None
+    except csv.Error as e:
+        raise InvalidArgument("cases", path, f"a CSV file ({e})") from None
+    except OSError as e:
+        raise InvalidArgument("cases", path, f"a readable CSV file ({e.strerror})") from None
+    if len(rows) < 2:
+        raise InvalidArgument("cases", path, "a CSV file with a header of override keys and at least one case row "
+                              f"(it has {'a header only' if rows else 'nothing'})")
+    header = [h.strip() for h in rows[0][1]]
+    if not all(header) or len(set(header)) < len(header):
+        raise InvalidArgument(f"cases header (line {rows[0][0]} of {path})", header, "distinct, non-empty override "
+                              "keys, e.g. scene.slope_angle,time.end")
+    for line, r in rows[1:]:
+        if len(r) != len(header):
+            raise InvalidArgument(f"cases row (line {line} of {path})", r, f"{len(header)} values, one per column of "
+                                  f"the header {header} (an empty cell is no override); it has {len(r)}")
+    return [{k: v.strip() for k, v in zip(header, r, strict=True) if v.strip()} for _, r in rows[1:]]
 
 
 def expand_cases(vary: dict | None = None, cases=None) -> list[dict]:
@@ -166,10 +192,11 @@ def _record(task: dict, status: str, error: str | None = None) -> dict:
 
 
 def _write_json(path: str, obj: dict) -> None:
-    tmp = f"{path}.{os.getpid()}.tmp"
-    with open(tmp, "w") as fh:
-        json.dump(obj, fh, indent=1, default=jsonable)
-    os.replace(tmp, path)
+    def write(tmp):
+        with open(tmp, "w") as fh:
+            json.dump(obj, fh, indent=1, default=jsonable)
+
+    io.atomic_write(path, write, "a sweep record")
 
 
 def _n_gpus() -> int:

@@ -5,9 +5,10 @@ from __future__ import annotations
 import csv
 import json
 import math
-import os
 
 import numpy as np
+
+from .io import atomic_write
 
 __all__ = ["RESULT_FIELDS", "summary_row", "write_summary", "plot_summary", "number", "jsonable"]
 
@@ -36,14 +37,16 @@ def summary_row(params: dict, rec: dict) -> dict:
 def write_summary(path: str, rows: list, first: list) -> None:
     """The rows as CSV (``first`` columns first), written aside and moved in place."""
     cols = list(dict.fromkeys([*first, *(k for r in rows for k in r)]))
-    tmp = f"{path}.{os.getpid()}.tmp"
-    with open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, cols, restval="")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: "" if v is None else json.dumps(v) if isinstance(v, (list, dict)) else v
-                        for k, v in r.items()})
-    os.replace(tmp, path)
+
+    def write(tmp):
+        with open(tmp, "w", newline="") as fh:
+            w = csv.DictWriter(fh, cols, restval="")
+            w.writeheader()
+            for r in rows:
+                w.writerow({k: "" if v is None else json.dumps(v) if isinstance(v, (list, dict)) else v
+                            for k, v in r.items()})
+
+    atomic_write(path, write, "the sweep summary")
 
 
 def number(v) -> float | None:
@@ -86,7 +89,4 @@ def plot_summary(rows: list, x: str, y: str, path: str, params=()) -> str | None
     ax.grid(alpha=0.3)
     if len(groups) > 1:
         ax.legend(fontsize="small")
-    tmp = f"{path}.{os.getpid()}.tmp"
-    fig.savefig(tmp, format="png", dpi=120)
-    os.replace(tmp, path)
-    return path
+    return atomic_write(path, lambda tmp: fig.savefig(tmp, format="png", dpi=120), "the sweep figure")

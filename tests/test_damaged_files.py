@@ -188,7 +188,8 @@ def test_blow_up_never_names_a_corrupt_checkpoint(tmp_path):
     c_p = mw.Elastic(1.0e6, 0.3, 250.0).p_wave_speed
     dt = 3.0 * 0.02 / c_p                      # three times the stable step: blows up within 40 steps
     overrides = [f"time.dt={dt!r}", f"time.end={40 * dt!r}", f"time.frame_interval={2 * dt!r}",
-                 "output.checkpoint_every=0", "output.health_every=1", "blocks.0.velocity=[0.0, -1.0, 0.0]"]
+                 "output.checkpoint_every=0", "output.health_every=1", "blocks.0.velocity=[0.0, -1.0, 0.0]",
+                 "time.allow_unstable_dt=true"]
     out = str(tmp_path / "run.h5")
     ckpt = io.checkpoint_path_for(out)
 

@@ -142,7 +142,8 @@ def test_lock_released_on_every_way_out(tmp_path):
     dt = 3.0 * 0.02 / c_p
     with pytest.raises(mw.SimulationBlowUp):                                   # a blow-up
         mw.run("elastic_block", str(out), "cpu", [f"time.dt={dt!r}", f"time.end={60 * dt!r}",
-                                                  f"time.frame_interval={20 * dt!r}"], overwrite=True)
+                                                  f"time.frame_interval={20 * dt!r}",
+                                                  "time.allow_unstable_dt=true"], overwrite=True)
     with pytest.raises(mw.InvalidArgument):                                    # refused after the lock was taken
         mw.run("elastic_block", str(out), "cpu", ["materials.snow.E=-1"], overwrite=True)
     _no_leftovers(tmp_path)

@@ -114,11 +114,10 @@ def test_stop_request_decides_between_the_frame_and_the_next_batch(capsys):
         assert sim.stops == 1
         with pytest.raises(KeyboardInterrupt):          # a third: at once
             stop._handle(signal.SIGTERM, None)
-    with StopRequest(far_s=2.0) as stop:                # a signal before the simulation exists
-        stop._handle(signal.SIGINT, None)
-        sim = _Sim()
-        stop.attach(sim)
-        assert sim.stops == 1
+    with StopRequest(far_s=2.0) as stop:                # a signal before the simulation exists: ends at once
+        with pytest.raises(KeyboardInterrupt) as info:
+            stop._handle(signal.SIGTERM, None)
+        assert info.value.signum == signal.SIGTERM and stop.sim is None
     err = capsys.readouterr().err
     assert "finishing the current frame" in err and "stopping after the current batch of steps" in err
 
@@ -162,10 +161,10 @@ def test_cli_signal_during_a_long_frame_stops_within_seconds_and_resumes_exactly
 def test_cli_resume_messages_and_end(tmp_path, capsys):
     out = str(tmp_path / "run.h5")
     mw.run("elastic_block", out, "cpu", ["time.end=0.04", "time.frame_interval=0.02", "output.checkpoint_every=1"])
-    assert main(["resume", out, "--end", "0.02"]) == 2                       # before the checkpoint's t = 0.04 s
+    assert main(["resume", out, "--end", "0.02"]) == 2                       # before the last frame's t = 0.04 s
     line, = capsys.readouterr().err.strip().splitlines()
-    assert line == ("mpm-warp: error: end_time = 0.02 is invalid: expected a time after the checkpoint's t = 0.04 s, "
-                    "from which the run continues")
+    assert line == (f"mpm-warp: error: end_time = 0.02 is invalid: expected a time after the last frame's t = 0.04 s: "
+                    f"{out} holds 3 frames to there and a resume never removes frames")
     assert main(["resume", out, "--end", "0.08"]) == 0
     cap = capsys.readouterr()
     steps = int(mw.read_run(out).steps[2])

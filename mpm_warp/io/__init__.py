@@ -7,9 +7,11 @@
 - :mod:`mpm_warp.io.opening`: :func:`open_read`, which never hangs on a damaged file;
 - :mod:`mpm_warp.io.lock`: :func:`output_lock`, one writer per run file;
 - :mod:`mpm_warp.io.paths`: :func:`check_output_file`, :func:`check_output_dir`: what may be written;
+- :mod:`mpm_warp.io.space`: a full disk (:class:`OutOfSpace`, :func:`atomic_write`);
 - :mod:`mpm_warp.io.hdf5`: format names and the helpers they share.
 """
 
+from ..errors import OutputError
 from .checkpoint import (
     checkpoint_is_intact,
     checkpoint_path_for,
@@ -22,7 +24,9 @@ from .lock import is_live, output_lock
 from .paths import check_output_dir, check_output_file
 from .rundata import RunData, read_run
 from .runfile import RunWriter
+from .space import OutOfSpace, atomic_write, ensure_space, space_errno
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "RunWriter", "RunData", "read_run",
            "write_checkpoint", "read_checkpoint", "read_checkpoint_meta", "checkpoint_path_for",
-           "checkpoint_is_intact", "output_lock", "is_live", "check_output_file", "check_output_dir"]
+           "checkpoint_is_intact", "output_lock", "is_live", "check_output_file", "check_output_dir", "OutOfSpace",
+           "atomic_write", "ensure_space", "space_errno", "OutputError"]

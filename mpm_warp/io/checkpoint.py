@@ -1,11 +1,19 @@
 """Checkpoints: the whole state of a run, written atomically (temporary file, fsync, ``os.replace``) and
-verified by a SHA-256 checksum when read."""
+verified by a SHA-256 checksum when read.
+
+The HDF5 file is built in memory (h5py's core driver, no backing store) and written with plain
+``os.write`` calls: HDF5 never writes to the disk itself, so a full disk is one clean ``OSError``
+(:class:`~mpm_warp.io.space.OutOfSpace`), never HDF5 failing half-way through closing its objects
+(which crashed the process: h5py closing a dataset whose flush had failed). The image costs one
+extra copy of the state in host memory while it is written.
+"""
 
 from __future__ import annotations
 
 import hashlib
 import json
 import os
+import uuid
 
 import h5py
 import numpy as np
@@ -13,6 +21,7 @@ import numpy as np
 from ..errors import OutputError
 from .hdf5 import CHECKPOINT_FORMAT, FORMAT_VERSION, check_format, now, to_json
 from .opening import DamagedFile, open_read, reading
+from .space import as_out_of_space, ensure_space, write_image
 
 __all__ = ["checkpoint_path_for", "write_checkpoint", "read_checkpoint", "read_checkpoint_meta", "checkpoint_digest",
            "checkpoint_is_intact"]
@@ -42,11 +51,26 @@ def _fsync(path: str) -> None:
         os.close(fd)
 
 
+def _image(arrays: dict[str, np.ndarray], meta_json: str) -> bytes:
+    """The checkpoint file's bytes, built in memory."""
+    f = h5py.File(f"mpm_warp-checkpoint-{uuid.uuid4().hex}.h5", "w", driver="core", backing_store=False)
+    try:
+        f.attrs.update(format=CHECKPOINT_FORMAT, format_version=FORMAT_VERSION, created=now(), meta=meta_json,
+                       sha256=checkpoint_digest(arrays, meta_json))
+        for name, a in arrays.items():
+            f.create_dataset(name, data=a)
+        f.flush()
+        return f.id.get_file_image()
+    finally:
+        f.close()
+
+
 def write_checkpoint(path, arrays: dict[str, np.ndarray], meta: dict) -> None:
     """Write the full state atomically: a temporary file, fsync, then ``os.replace``.
 
-    A process killed mid-write leaves the previous checkpoint intact. The file carries the
-    SHA-256 of its arrays and meta (attribute ``sha256``, :func:`checkpoint_digest`).
+    A process killed mid-write, or a full disk, leaves the previous checkpoint intact and no
+    temporary file; the lack of space raises :class:`~mpm_warp.io.space.OutOfSpace`. The file
+    carries the SHA-256 of its arrays and meta (attribute ``sha256``, :func:`checkpoint_digest`).
 
     Parameters
     ----------
@@ -59,19 +83,18 @@ def write_checkpoint(path, arrays: dict[str, np.ndarray], meta: dict) -> None:
     path = os.fspath(path)
     tmp = path + ".tmp"
     arrays = {name: np.asarray(a) for name, a in arrays.items()}
-    meta_json = to_json(meta)
+    image = _image(arrays, to_json(meta))
     try:
-        with h5py.File(tmp, "w") as f:
-            f.attrs.update(format=CHECKPOINT_FORMAT, format_version=FORMAT_VERSION, created=now(), meta=meta_json,
-                           sha256=checkpoint_digest(arrays, meta_json))
-            for name, a in arrays.items():
-                f.create_dataset(name, data=a)
-        _fsync(tmp)
+        ensure_space(path, len(image), "the checkpoint")
+        write_image(tmp, image)
         os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
+    except BaseException as e:
+        if os.path.lexists(tmp):
             os.remove(tmp)
-        raise
+        err = as_out_of_space(e, path, "the checkpoint")
+        if err is e:
+            raise
+        raise err from None
     try:                                      # make the rename durable too
         _fsync(os.path.dirname(os.path.abspath(path)))
     except OSError:                           # directories cannot be fsynced everywhere

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import datetime
 import json
+import os
 
 import h5py
 import numpy as np
@@ -13,7 +14,7 @@ from .opening import DamagedFile, open_read
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "now", "to_json", "set_attrs", "get_attrs", "open_read",
            "check_format", "series_datasets", "layout", "check_name", "LIBVER", "PAGE", "series_chunk",
-           "RESERVED_ATTRS", "COMPRESSION"]
+           "RESERVED_ATTRS", "COMPRESSION", "pad_to_stored_eof", "stored_eof"]
 
 FORMAT = "mpm_warp-run"
 FORMAT_VERSION = 1
@@ -107,3 +108,39 @@ def check_name(kind: str, name: str) -> None:
     if not isinstance(name, str) or not name or "/" in name or name in (".", "time", "step"):
         raise InvalidArgument(kind, name, "a non-empty name without '/', not 'time' or 'step'")
 
+
+
+def stored_eof(path: str) -> int | None:
+    """The end-of-file address a run file's superblock records (versions 2 and 3, ``libver="v110"``), else None."""
+    with open(path, "rb") as fh:
+        head = fh.read(36)
+    # superblock v2/v3: signature (8), version, sizes of offsets and lengths, flags, base, extension, EOF address
+    if len(head) < 36 or head[:8] != b"\x89HDF\r\n\x1a\n" or head[8] not in (2, 3) or head[9] != 8:
+        return None
+    return int.from_bytes(head[28:36], "little")
+
+
+def pad_to_stored_eof(path: str, check=None) -> int:
+    """Extend a run file shorter than the end of file its superblock records, with a hole; return the bytes added.
+
+    A write that found no room can leave the superblock's end-of-file address (updated by an SWMR
+    flush) past the bytes that reached the disk; HDF5 then refuses the whole file ("truncated file").
+    The missing bytes belong to the frame that failed, which is not complete: a hole of zeros in
+    their place (no disk space on the usual file systems) makes the complete frames readable again.
+    A file that then fails ``check(path)`` (default: it opens) is cut back to its own bytes: a file
+    truncated by other means is left exactly as it was.
+    """
+    eof, size = stored_eof(path), os.path.getsize(path)
+    if eof is None or size >= eof or eof - size > 1 << 34:   # not short, or an address no run file writes
+        return 0
+    os.truncate(path, eof)
+    try:
+        if check is None:
+            with open_read(path):
+                pass
+        else:
+            check(path)
+    except (OSError, OutputError):
+        os.truncate(path, size)
+        return 0
+    return eof - size

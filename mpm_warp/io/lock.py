@@ -131,8 +131,13 @@ def output_lock(path):
         os.ftruncate(fd, 0)
         os.pwrite(fd, json.dumps(me).encode(), 0)
         _HELD[key] = [fd, 1]
-    except BaseException:
+    except BaseException as e:
+        with contextlib.suppress(OSError):
+            os.unlink(lock_path_for(path))
         os.close(fd)
+        if isinstance(e, OSError) and not isinstance(e, OutputError):
+            raise OutputError(f"{path}: cannot write its lock file {lock_path_for(path)} ({e.strerror}); nothing "
+                              "was written") from None
         raise
     try:
         yield

@@ -12,7 +12,7 @@ import os
 import stat
 import tempfile
 
-from ..errors import OutputError
+from ..errors import InvalidArgument, OutputError
 from .checkpoint import checkpoint_path_for
 
 __all__ = ["check_output_file", "check_output_dir"]
@@ -51,7 +51,14 @@ def check_output_file(path, *, overwrite: bool = False, inputs=(), append: bool 
     append : bool
         The run continues ``path`` (resume): it must exist.
     """
+    for name, value in (("overwrite", overwrite), ("append", append)):
+        if not isinstance(value, bool):
+            raise InvalidArgument(name, value, "True or False")
+    if not isinstance(path, (str, os.PathLike)):
+        raise InvalidArgument("output", path, "a file path (str or os.PathLike)")
     path = os.fspath(path)
+    if not isinstance(path, str):
+        raise InvalidArgument("output", path, "a file path (str or os.PathLike of str)")
     if not path:
         raise OutputError("output: an empty file name")
     _writable_dir(path, os.path.dirname(os.path.abspath(path)))

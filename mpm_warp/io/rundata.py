@@ -39,6 +39,8 @@ class RunData:
     """
 
     def __init__(self, path):
+        if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
+            raise InvalidArgument("path", path, "a run file path (str or os.PathLike)")
         self.path = os.fspath(path)
         with open_read(self.path) as f, reading(self.path, "reading its layout and series"):
             self._swmr = f.swmr_mode      # later reads open the file the same way, without a new probe
@@ -75,7 +77,7 @@ class RunData:
 
     def frame(self, i: int) -> dict[str, np.ndarray]:
         """Particle fields of complete frame ``i`` (negative counts from the end)."""
-        if not -self.n_frames <= i < self.n_frames:
+        if isinstance(i, bool) or not isinstance(i, (int, np.integer)) or not -self.n_frames <= i < self.n_frames:
             raise InvalidArgument("frame", i, f"an index in [{-self.n_frames}, {self.n_frames})")
         with open_read(self.path, self._swmr, probed=True) as f, reading(self.path, f"frame {i}"):
             return {k: f[f"particles/{k}"][i % self.n_frames] for k in self.particle_fields}

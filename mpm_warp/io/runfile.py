@@ -18,42 +18,19 @@ data: ``"gzip"`` = shuffle + gzip level 1 (any HDF5 tool reads it; level 4 was n
 10-30 % slower), ``"lzf"`` = shuffle + LZF (about 3.5x faster to write, ~10 % larger, an
 h5py-only filter), ``"none"``.
 
-Crash safety: a frame is written whole or not at all
-----------------------------------------------------
-Files use superblock v3 (``libver="v110"``, read by HDF5 >= 1.10) and are written in SWMR
-mode, in which HDF5 orders its metadata writes (flush dependencies) so that the file is
-consistent after any prefix of them, and ``H5Fflush`` writes raw chunks before metadata.
-:meth:`RunWriter.write_frame` checks every input, grows and fills each per-frame dataset
-(``time`` last) and flushes. A frame is complete when every per-frame dataset holds its row;
-readers take ``n_frames = min(lengths)``, so a kill between two dataset headers, or an
-exception between two datasets, never shows a partial frame. A file is never touched outside
-SWMR mode: it is built aside (``<path>.part``), switched to SWMR, then renamed over ``path``.
-A killed writer (SIGKILL, default SIGTERM, OOM) leaves the superblock marked "open for write",
-which plain HDF5 refuses ("use h5clear"); :func:`read_run` then opens it with ``swmr=True``
-(as it does runs still being written), after a time-boxed probe (:mod:`mpm_warp.io.opening`:
-an SWMR open of a damaged file would never return). SIGINT raises ``KeyboardInterrupt``
-between HDF5 calls and ``__exit__`` closes the file cleanly. :meth:`RunWriter.reopen` (resume)
-reads every kept frame once (a damaged one stops the resume) and copies them chunk by chunk
-(raw bytes, no recompression) into a rebuilt file that replaces the old one, so a kill during
-resume leaves the old file or the new one. Verified by killing a writer (strace
-fault injection) at every one of its ``pwrite`` calls.
-
-A kill can also land *inside* one ``pwrite``: Linux copies a write into the page cache page by
-page and stops between two pages for a fatal signal, so a rewrite in place of bytes spanning
-two pages can be left half new, half old, and fail its checksum for good. Files therefore use
-HDF5 paged aggregation with 4 KiB pages (:data:`~mpm_warp.io.hdf5.PAGE`; an object smaller
-than a page never straddles two), and the small series, whose last chunk is rewritten at every
-frame, get chunks of one page at most (:func:`~mpm_warp.io.hdf5.series_chunk`: 511 frames of
-``time``); particle frames are one chunk each, written once into new space. Measured (strace):
-up to about 8000 frames no rewrite in place spans two pages; beyond that HDF5 rewrites the
-7 KiB pages of the particle datasets' chunk index, and a kill inside one of those can still
-damage a file (the checkpoint, written aside and renamed, is not affected). Protected: death of
-the process. Not protected: power loss (no fsync per frame), network file systems (no SWMR
-write ordering).
+Crash safety (docs/robustness.md, "How files are kept safe")
+-------------------------------------------------------------
+Superblock v3, SWMR writes (HDF5 orders its metadata so that any prefix of the writes is a
+consistent file), 4 KiB paged aggregation, one chunk per particle frame; a frame is complete
+when every per-frame dataset holds its row (readers take ``min(lengths)``). A new or rebuilt
+file is written aside (``<path>.part``, its layout built in memory) and renamed over ``path``.
+Free space is checked before each frame; a write that finds no room raises
+:class:`~mpm_warp.io.space.OutOfSpace` and leaves the complete frames readable.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 
@@ -64,7 +41,6 @@ from ..errors import InvalidArgument, OutputError
 from .hdf5 import (
     COMPRESSION,
     FORMAT,
-    FORMAT_VERSION,
     LIBVER,
     OUTCOME_BYTES,
     PAGE,
@@ -75,13 +51,18 @@ from .hdf5 import (
     layout,
     now,
     open_read,
-    series_chunk,
+    pad_to_stored_eof,
     series_datasets,
-    set_attrs,
 )
+from .layout import copy_chunks, skeleton
 from .opening import reading
+from .space import as_out_of_space, ensure_space, space_errno, write_image
 
 __all__ = ["RunWriter"]
+
+#: free space a write needs beyond its raw bytes and a page per dataset: HDF5's metadata pages (chunk indices,
+#: object headers), bytes
+_METADATA_MARGIN = 16 * PAGE
 
 
 class RunWriter:
@@ -125,6 +106,9 @@ class RunWriter:
                  attrs: dict | None = None, compression: str = "gzip", overwrite: bool = True,
                  append: bool = False, keep_frames: int | None = None, verify: bool = True):
         self.path, self._f, self._verify = os.fspath(path), None, verify
+        for name, value in (("overwrite", overwrite), ("append", append), ("verify", verify)):
+            if not isinstance(value, bool):
+                raise InvalidArgument(name, value, "True or False")
         if not isinstance(n_particles, (int, np.integer)) or n_particles < 1:
             raise InvalidArgument("n_particles", n_particles, "an integer >= 1")
         if compression not in COMPRESSION:
@@ -156,6 +140,11 @@ class RunWriter:
         if len(set(names)) < len(names):
             raise InvalidArgument("field names", names, "names unique across particle fields, "
                                   "scalars, static fields and 'wall_forces'")
+        #: the most bytes one frame adds to the file (its rows uncompressed, and a page per dataset)
+        rows = sum(self.n_particles * dt.itemsize * int(np.prod(sh)) for sh, dt, _ in self._fields.values())
+        self._frame_bytes = rows + 8 * (len(self._scalars) + 2) + 24 * len(self.wall_names) \
+            + PAGE * (len(self._fields) + len(self._scalars) + 3) + _METADATA_MARGIN
+        self._failed, self._last_time = False, None
         attrs = dict(attrs or {})
         if RESERVED_ATTRS & attrs.keys():
             raise InvalidArgument("attrs keys", sorted(RESERVED_ATTRS & attrs.keys()),
@@ -208,63 +197,39 @@ class RunWriter:
 
     def _build(self, static, attrs, compression, src=None, keep=0) -> h5py.File:
         """Write the file aside, with the first ``keep`` frames of ``src`` if given, switch it to
-        SWMR mode and move it over ``path``: a kill leaves the old file or the new one."""
+        SWMR mode and move it over ``path``: a kill leaves the old file or the new one.
+
+        Its layout (and the small series of the kept frames) is built in memory and written with
+        plain writes (:func:`~mpm_warp.io.layout.skeleton`), so a full disk there is one clean error; HDF5 itself then
+        writes only the kept particle frames, after a check that the space for them is free.
+        """
         part = self.path + ".part"
-        f = h5py.File(part, "w", libver=LIBVER, fs_strategy="page", fs_page_size=PAGE)
+        need = sum(a.nbytes for a, _ in static.values()) + self._frame_bytes + _METADATA_MARGIN   # and a first frame
+        ensure_space(self.path, need + (os.path.getsize(self.path) if src and keep else 0),
+                     "the run file" + (f" rebuilt with its {keep} frames" if src and keep else ""))
+        f = None
         try:
-            f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, n_particles=self.n_particles,
-                           created=src.attrs["created"] if src else now())
-            versions = {"h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
-                        "numpy": np.__version__} | (attrs.get("versions") or {})
-            units = {"length": "m", "time": "s", "mass": "kg", "force": "N", "energy": "J"}
-            set_attrs(f, {**attrs, "versions": versions, "units": units | (attrs.get("units") or {})})
-            f.attrs.create("outcome", np.bytes_(b"{}".ljust(OUTCOME_BYTES)), dtype=f"S{OUTCOME_BYTES}")
-            n, filt = self.n_particles, COMPRESSION[compression]
-
-            def series(name, dtype, unit, shape=(), chunk=None, **kw):
-                chunk = chunk or series_chunk(np.dtype(dtype).itemsize * int(np.prod(shape)))
-                d = f.create_dataset(name, shape=(keep, *shape), maxshape=(None, *shape), dtype=dtype,
-                                     chunks=(chunk, *shape), fletcher32=True, **kw)
-                d.attrs["unit"] = unit
-                if not (src and keep):
-                    return d
-                s = src[name]
-                with reading(self.path, f"{name}, in the {keep} frames the resume keeps"):
-                    if chunk == 1 and s.chunks == d.chunks and \
-                            (s.compression, s.shuffle, s.fletcher32) == (d.compression, d.shuffle, d.fletcher32):
-                        for i in range(s.id.get_num_chunks()):   # copy compressed bytes as is, once verified
-                            info = s.id.get_chunk_info(i)
-                            if info.chunk_offset[0] < keep:
-                                if self._verify:
-                                    s[info.chunk_offset[0]]          # decompress: the checksum is checked
-                                raw = s.id.read_direct_chunk(info.chunk_offset)[1]
-                                d.id.write_direct_chunk(info.chunk_offset, raw, info.filter_mask)
-                    else:
-                        for i in range(0, keep, chunk):
-                            d[i:i + chunk] = s[i:min(i + chunk, keep)]
-                return d
-
-            series("time", "f8", "s")
-            series("step", "i8", "1")
-            f.create_group("particles", track_order=True)
-            for name, (shape, dtype, unit) in self._fields.items():
-                series(f"particles/{name}", dtype, unit, (n, *shape), chunk=1, **filt)
-            f.create_group("static", track_order=True)
-            for name, (array, unit) in static.items():
-                f.create_dataset(f"static/{name}", data=array, fletcher32=True, **filt).attrs["unit"] = unit
-            f.create_group("scalars", track_order=True)
-            for name, unit in self._scalars.items():
-                series(f"scalars/{name}", "f8", unit)
-            if self.wall_names:
-                series("walls/forces", "f8", "N", (len(self.wall_names), 3)).attrs["names"] = \
-                    json.dumps(self.wall_names)
+            write_image(part, skeleton(self.path, self.n_particles, self._fields, self._scalars, self.wall_names,
+                                        static, attrs, compression, src, keep))
+            f = h5py.File(part, "r+", libver=LIBVER)
+            if src and keep:
+                for name in self._fields:
+                    copy_chunks(self.path, src[f"particles/{name}"], f[f"particles/{name}"], keep, self._verify)
             f.swmr_mode = True                # flushes; from here on datasets only grow
             os.replace(part, self.path)
             return f
-        except BaseException:
-            f.close()
-            os.remove(part)
-            raise
+        except BaseException as e:
+            if f is not None:
+                try:
+                    f.close()
+                except Exception:             # a close that cannot flush (a full disk): the file is removed anyway
+                    pass
+            if os.path.lexists(part):
+                os.remove(part)
+            err = as_out_of_space(e, self.path, "the run file")
+            if err is e:
+                raise
+            raise err from None
 
     @property
     def n_frames(self) -> int:
@@ -323,11 +288,23 @@ class RunWriter:
             rows["walls/forces"] = w
         rows["step"], rows["time"] = int(step), time          # time is written last
         n = self._n
-        for name, value in rows.items():
-            self._datasets[name].resize(n + 1, axis=0)
-            self._datasets[name][n] = value
-        self._f.flush()
-        self._n = n + 1
+        if self._failed:
+            raise OutputError(f"{self.path}: a write failed before; the writer holds {n} complete frames and "
+                              "writes no more")
+        ensure_space(self.path, self._frame_bytes, f"frame {n}")
+        try:
+            for name, value in rows.items():
+                self._datasets[name].resize(n + 1, axis=0)
+                self._datasets[name][n] = value
+            self._f.flush()
+        except Exception as e:
+            err = as_out_of_space(e, self.path, f"frame {n}")
+            if err is e:
+                raise
+            self._failed = True
+            err.frames, err.last_time = n, self._last_time
+            raise err from None
+        self._n, self._last_time = n + 1, time
         return n
 
     def set_outcome(self, outcome: dict) -> None:
@@ -340,16 +317,30 @@ class RunWriter:
         self._f.flush()
 
     def close(self) -> None:
-        """Trim a partly written frame (left by an exception) and close the file."""
+        """Trim a partly written frame (left by an exception) and close the file.
+
+        After a write that found no room the trim and the close's flush may fail too: they are
+        given up quietly (readers take the complete frames, ``min`` of the lengths, either way).
+        """
         if self._f is None:
             return
+        f, self._f, trim_error = self._f, None, None
         try:
             for d in self._datasets.values():
                 if d.shape[0] != self._n:
                     d.resize(self._n, axis=0)
-        finally:
-            self._f.close()
-            self._f = None
+        except BaseException as e:
+            trim_error = e
+        try:
+            f.close()
+        except Exception as e:
+            if not (self._failed or space_errno(e)):
+                raise
+        if self._failed:                      # a flush that found no room may have left the file short of its end
+            with contextlib.suppress(OSError):
+                pad_to_stored_eof(self.path)
+        if trim_error is not None and not (self._failed or space_errno(trim_error)):
+            raise trim_error
 
     def __enter__(self) -> RunWriter:
         return self

@@ -17,7 +17,8 @@ from ..scenes.pst import PSTParams
 from ..scenes.pst.analysis import MEAN_SPEED_DISTANCE, end_zone
 from ..scenes.weak_layer import CalibratedWeakLayer
 
-__all__ = ["scene_params", "scene_calibration", "front_name", "fit_front_speed", "front_speed", "front_and_saw_x"]
+__all__ = ["scene_params", "scene_calibration", "front_name", "fit_front_speed", "front_speed", "front_and_saw_x",
+           "fronts_x"]
 
 
 def scene_params(run: RunData):
@@ -106,20 +107,28 @@ def front_speed(run: RunData) -> dict:
     return fit_front_speed(t, xf)
 
 
-def front_and_saw_x(run: RunData) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """Crack front and saw blade as x [m] per frame, NaN where there is none.
+def fronts_x(run: RunData) -> dict[str, np.ndarray | None]:
+    """The damage front, the slab-deflection front and the saw blade as x [m] per frame (NaN: none yet).
 
-    ``front_position`` / ``saw_position`` are x already; a PST's ``front`` / ``saw`` are distances from
-    the saw's starting end (``saw.from_end``), 0 before there is any.
+    Keys ``damage``, ``deflection``, ``saw``; a value is None when the run stores no such series.
+    ``front_position`` / ``saw_position`` are x already; a PST's ``front``, ``deflection_front`` and
+    ``saw`` are distances from the saw's starting end (``saw.from_end``), 0 before there is any.
     """
     params = scene_params(run)
-    out = []
-    for x_name, s_name in (("front_position", "front"), ("saw_position", "saw")):
+    out = {}
+    for key, x_name, s_name in (("damage", "front_position", "front"), ("deflection", None, "deflection_front"),
+                                ("saw", "saw_position", "saw")):
         if x_name in run.scalars:
-            out.append(run.scalars[x_name])
+            out[key] = run.scalars[x_name]
         elif s_name in run.scalars:
             s = np.where(run.scalars[s_name] > 0, run.scalars[s_name], np.nan)
-            out.append(params.distance_from_cut_end(s) if isinstance(params, PSTParams) else s)
+            out[key] = params.distance_from_cut_end(s) if isinstance(params, PSTParams) else s
         else:
-            out.append(None)
-    return out[0], out[1]
+            out[key] = None
+    return out
+
+
+def front_and_saw_x(run: RunData) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Crack front and saw blade as x [m] per frame, NaN where there is none (see :func:`fronts_x`)."""
+    f = fronts_x(run)
+    return f["damage"], f["saw"]

@@ -20,6 +20,7 @@ import os
 
 import numpy as np
 
+from ..errors import InvalidArgument
 from ..io import RunData, read_run
 from ..scenes.pst import PSTParams
 from ..scenes.pst.analysis import end_zone
@@ -77,10 +78,10 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     run = path if isinstance(path, RunData) else read_run(path)
     params = scene_params(run)
     if not isinstance(params, PSTParams):
-        raise ValueError(f"{run.path}: not a PST run")
+        raise InvalidArgument("path", run.path, "a PST run file (scene kind 'pst')")
     missing = [f for f in ("x", "log_jp", "log_jp_ref") if f not in run.particle_fields]
     if missing:
-        raise ValueError(f"{run.path}: a PST picture needs the particle fields {missing} in the output")
+        raise InvalidArgument("path", run.path, f"a PST run with the particle fields {missing} in its output")
     k = running_frame(run, params) if frame is None else int(frame) % run.n_frames
     groups = [g["name"] for g in run.attrs["groups"]]
     gid = run.static["group"]
@@ -97,6 +98,7 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     t = float(run.times[k])
     front = float(run.scalars["front"][k])
     dfront = float(run.scalars["deflection_front"][k]) if "deflection_front" in run.scalars else None
+    dfront = dfront if dfront else None          # 0: no slab-deflection front yet (drawn at the cut end otherwise)
     saw = float(run.scalars["saw"][k]) if "saw" in run.scalars else 0.0
     to_x = params.distance_from_cut_end          # distances from the cut end <-> x (its own inverse)
 
@@ -116,7 +118,7 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     sc = ax.scatter(shown[wl, 0], shown[wl, 1], s=2.5, c=collapse, cmap=CMAP, vmin=0.0, vmax=c_max, lw=0,
                     rasterized=True)
     y_top = params.base_y + D
-    for s, style, label in ((front, "-", f"damage front {front:.2f} m"),
+    for s, style, label in ((front if front > 0 else None, "-", f"damage front {front:.2f} m"),
                             (dfront, "--", f"slab-deflection front {dfront:.2f} m" if dfront is not None else ""),
                             (saw, ":", f"saw blade {saw:.2f} m (cut {cut:.2f} m)")):
         if s is None:
@@ -127,7 +129,7 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     ax.set(xlim=(-0.05, L + 0.05), ylim=(-0.03, y_top + 0.08), xlabel="x along the column [m]", ylabel="y [m]")
     ax.set_aspect(max(1.0, 0.3 * (L + 0.1) / (y_top + 0.11)), adjustable="box")   # a column ~0.3 as high as long
     ax.legend(loc="lower right", fontsize=7, ncols=2, framealpha=0.9)
-    cb = fig.colorbar(sc, ax=[ax, az], shrink=0.8, pad=0.01)
+    cb = fig.colorbar(sc, ax=[ax, az], shrink=0.8, pad=0.01, panchor=False)   # a short column stays centred
     cb.set_label("weak-layer collapse since settling, 1 - J_P/J_P,ref [-]\n(white: the law under the slab at rest)")
     cb.ax.axhline(h_c / params.weak_layer_thickness, color="w", lw=2)
     # ---------------------------------------------------------------- zoom on the layer at the front
@@ -139,7 +141,8 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     zw = box[wl]
     az.scatter(x[wl][zw, 0], x[wl][zw, 1], s=5.0, c=collapse[zw], cmap=CMAP, vmin=0.0, vmax=c_max, lw=0,
                rasterized=True)
-    az.axvline(xf, color="magenta", lw=1.3)
+    if front > 0:
+        az.axvline(xf, color="magenta", lw=1.3)
     if dfront is not None:
         az.axvline(float(to_x(dfront)), color="k", ls="--", lw=1.0)
     az.axhline(params.base_y, color="0.3", lw=0.6, ls=":")
@@ -154,14 +157,14 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
         return (bb.height / (y1 - y0)) / (bb.width / (x1 - x0))
 
     outcome = (run.attrs.get("outcome") or {}).get("pst") or {}
-    line = f"{outcome['field_line']}\n" if outcome.get("field_line") else ""
+    line = f"{outcome['field_line']}: " if outcome.get("field_line") else ""
     if outcome.get("class") == "SF" and np.isfinite(outcome.get("slab_fracture_at", np.nan)):
         xs = float(to_x(outcome["slab_fracture_at"]))
         ax.annotate(f"slab fracture {outcome['slab_fracture_at']:.2f} m", (xs, y_top), (xs, y_top + 0.045),
                     color="crimson", fontsize=8, ha="center", arrowprops=dict(arrowstyle="->", color="crimson"))
-    ax.set_title(f"{line}{run.scenario.get('name', 'PST')} at t = {t:.3f} s; displacements since settling "
-                 f"exaggerated x{f:.0f}, vertical axis stretched "
-                 f"x{stretch(ax, -0.05, L + 0.05, -0.03, y_top + 0.08):.1f}")
+    k = stretch(ax, -0.05, L + 0.05, -0.03, y_top + 0.08)
+    ax.set_title(f"{line}{run.scenario.get('name', 'PST')} at t = {t:.3f} s\ndisplacements since settling "
+                 f"exaggerated x{f:.0f}, vertical axis stretched x{k:.1f}")
     az.set_title(f"zoom on the weak layer at the damage front: true displacements, vertical axis stretched "
                  f"x{stretch(az, lo, hi, y0, y1):.0f}")
     os.makedirs(os.path.dirname(os.path.abspath(out_png)), exist_ok=True)

@@ -4,11 +4,19 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["View", "fixed_camera", "spacing", "FRONT_COLOR", "BELOW_COLOR", "CMAP"]
+__all__ = ["View", "fixed_camera", "spacing", "FRONT_COLOR", "DEFLECTION_COLOR", "SAW_COLOR", "BELOW_COLOR",
+           "INERT_COLOR", "CMAP"]
 
-FRONT_COLOR = (255, 0, 255)              # magenta: absent from the viridis colour map
+FRONT_COLOR = (255, 0, 255)              # magenta, solid: the damage front (absent from the viridis colour map)
+DEFLECTION_COLOR = (230, 97, 1)          # dark orange, dashed: the slab-deflection front (absent from viridis too)
+SAW_COLOR = (70, 70, 70)                 # dark grey, dotted: the saw blade
 BELOW_COLOR = (190, 190, 190)            # particles below the colour range (e.g. a sawn weak layer)
+INERT_COLOR = (222, 222, 222)            # particles without the field (NaN): the elastic slab and old snow under
+                                         # "collapse", lighter than BELOW_COLOR
 CMAP = "viridis"
+#: the vertical lines of a frame: name -> (colour, segments over the height (1: solid), depth offset in spacings);
+#: drawn in this order, nearer the camera down the list (where they coincide the damage front shows)
+LINES = {"saw": (SAW_COLOR, 60, 0.0), "deflection": (DEFLECTION_COLOR, 24, 0.3), "front": (FRONT_COLOR, 1, 0.6)}
 
 
 def _nice(length: float) -> float:
@@ -78,7 +86,7 @@ class View:
             bar["below_label"] = f"< {clim[0]:.3g}"
         pl.add_mesh(self.cloud, scalars=field, cmap=CMAP, clim=clim, render_points_as_spheres=spheres,
                     lighting=spheres, point_size=float(size), scalar_bar_args=bar,
-                    below_color=BELOW_COLOR if below else None)
+                    below_color=BELOW_COLOR if below else None, nan_color=INERT_COLOR)
         pl.camera_position = [cam["position"], cam["focal_point"], cam["view_up"]]
         pl.camera.parallel_projection = True
         pl.camera.parallel_scale = cam["parallel_scale"]
@@ -89,6 +97,7 @@ class View:
         pl.add_axes(color="black", line_width=3, viewport=(0.0, 0.0, 0.14, 0.22))
         # scale bar: a round length along x, 28 pixels below the particles, its label under it
         self.z, pad = hi[2] + 2 * spacing, 1.0 / ppm
+        self.z_pad = spacing
         self.y_span, self.y_mid = (lo[1] - 12 * pad, hi[1] + 12 * pad), 0.5 * (lo[1] + hi[1])
         length, y_bar = _nice(0.3 * (hi[0] - lo[0]) or 1.0), lo[1] - 28 * pad
         pl.add_mesh(pv.Line((lo[0], y_bar, self.z), (lo[0] + length, y_bar, self.z)), color="black",
@@ -106,22 +115,37 @@ class View:
         """Font size scaled with the image height (sizes are given for 720 pixels)."""
         return max(9, round(points * self.size[1] / 720))
 
-    def shoot(self, png: str, x, values, text: str, front: float | None) -> float | None:
-        """Render one frame to ``png``; return the front marker's image column (None: no front)."""
+    def shoot(self, png: str, x, values, text: str, front: float | None, deflection: float | None = None,
+              saw: float | None = None, note: str = "") -> tuple[float | None, float | None]:
+        """Render one frame to ``png`` with its vertical lines at x [m] (None: not drawn): the damage front
+        solid magenta, the slab-deflection front dashed orange, the saw blade dotted grey (:data:`LINES`);
+        ``text`` (the time) on the top line, ``note`` (the lines' positions) under the title.
+
+        Returns the image columns of the damage and the deflection front (None where not drawn).
+        """
         pl, (w, h) = self.pl, self.size
         self.cloud.points = x
         self.cloud.point_data[self.field] = values
-        col = None
-        if front is not None:
-            line = self._pv.Line((front, self.y_span[0], self.z), (front, self.y_span[1], self.z))
-            pl.add_mesh(line, color=FRONT_COLOR, line_width=3, lighting=False, name="front", reset_camera=False)
-            col = _to_pixel(pl.renderer, (front, self.y_mid, self.z), h)[0]
-        else:
-            pl.remove_actor("front", reset_camera=False)
+        cols = {}
+        for name, xf in (("saw", saw), ("deflection", deflection), ("front", front)):
+            color, segments, dz = LINES[name]
+            if xf is None:
+                pl.remove_actor(name, reset_camera=False)
+                cols[name] = None
+                continue
+            z = self.z + dz * self.z_pad
+            ys = np.linspace(self.y_span[0], self.y_span[1], 2 * segments)
+            pts = np.column_stack([np.full(len(ys), xf), ys, np.full(len(ys), z)])
+            line = self._pv.PolyData(pts, lines=np.array([[2, i, i + 1] for i in range(0, len(ys), 2)]).ravel())
+            pl.add_mesh(line, color=color, line_width=3 if segments < 50 else 2, lighting=False, name=name,
+                        reset_camera=False)
+            cols[name] = _to_pixel(pl.renderer, (xf, self.y_mid, z), h)[0]
         pl.add_text(text, position=(12, h - 2.4 * self._fs(14)), font_size=self._fs(14), color="black", name="time")
+        pl.add_text(note, position=(12, h - 2.4 * self._fs(14) - 4 * self._fs(11)), font_size=self._fs(11),
+                    color="black", name="note")
         pl.renderer.ResetCameraClippingRange()
         pl.screenshot(png, window_size=(w, h))
-        return col
+        return cols["front"], cols["deflection"]
 
     def close(self) -> None:
         self.pl.close()
