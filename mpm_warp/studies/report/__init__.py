@@ -15,8 +15,9 @@ file's JSON that returns the Markdown lines of its tables and findings, register
         rows = [[c["name"], fx(c["speed"], 1)] for c in data["cases"]]
         return table(["case", "speed (m/s)"], rows) + ["", env_note(data)]
 
-in the module of its part (:mod:`.perf`, :mod:`.convergence`, :mod:`.snow_runs`, :mod:`.snow_studies`;
-sections appear in the order they are registered). Format every number with :mod:`.fmt` and put the
+in the module of its part (:mod:`.perf`, :mod:`.convergence`, :mod:`.snow_runs`, :mod:`.snow_studies`,
+:mod:`.robustness`; the parts are :data:`.core.PARTS`, in that order, and within a part the sections appear
+in the order they are registered). Format every number with :mod:`.fmt` and put the
 environment note (:func:`.fmt.env_note`) under the table. A study whose JSON is not committed yet is
 registered with :func:`.core.pending` (its section says "not measured yet" until the file appears); a file
 that does not exist is always skipped with that line, so a section can be written before its first run.
@@ -29,7 +30,7 @@ import argparse
 import os
 import sys
 
-from . import convergence, perf, snow_runs, snow_studies  # noqa: F401  (registration, in document order)
+from . import convergence, perf, robustness, snow_runs, snow_studies  # noqa: F401  (registration)
 from .core import DOC, SECTIONS, Context, document, pending, section
 from .readme import headlines, with_block
 

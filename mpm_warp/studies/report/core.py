@@ -20,7 +20,7 @@ from .fmt import environment_of
 __all__ = ["PARTS", "Section", "Context", "SECTIONS", "section", "pending", "document", "slug"]
 
 #: The parts of the document, in order: key -> heading.
-PARTS = {"perf": "Performance", "convergence": "Convergence", "snow": "Snow science"}
+PARTS = {"perf": "Performance", "convergence": "Convergence", "snow": "Snow science", "robustness": "Robustness"}
 
 DOC = "docs/results.md"
 
