@@ -134,7 +134,7 @@ def test_bonded_return_section_formats_the_json(root):
     assert lines[i + 3] == "| yield_far | 1,000 | 98 % / 50 % | 4145.5 | 212.9 | 19.47 |"
     assert lines[i + 5] == ("*Measured on cpu (x86_64, 2 cores), 2026-11-30, load average 3.1 at the start; "
                             "warp 1.19.0.*")
-    assert lines[i + 7] == "float32, one launch over all points, fastest of 2 repeats."
+    assert lines[i + 7] == "float32, one launch over all points: the median of 2 launches after a compiling one."
 
 
 def test_a_result_not_committed_says_not_measured_yet(root):

@@ -41,7 +41,8 @@ def render_error_vs_runtime(data: dict, ctx) -> list[str]:
     out += ["", env_note(data), "",
             f"dx halving at CFL {fx(st.get('cfl_dx_ladder'), 1)}, {st.get('particles_per_cell_per_axis')} particles "
             f"per cell and axis; the CFL ladder ({', '.join(fx(c, 1) for c in st.get('cfl_ladder', []))}) at one dx. "
-            f"Wall time: stepping only, median of {st.get('repeats')} runs, one thread. The references:", ""]
+            f"Wall time: stepping only, median of {st.get('repeats')} runs, {data['environment'].get('n_threads')} "
+            "CPU thread(s). The references:", ""]
     out += [f"- `{name}`: {p['reference']}." for name, p in data["problems"].items()]
     for name, p in data["problems"].items():
         out += ["", f"`{name}`, every level:", ""]

@@ -181,8 +181,9 @@ def render_leave_out(data: dict, ctx) -> list[str]:
              pct(c.get("fraction_with_plastic_history"), 0)] for k, c in data["cases"].items()]
     out = table(["case", "particles", "walls", "M particle-steps/s", "time against elastic without walls",
                  "bytes per particle", "with plastic history"], rows)
-    return out + ["", env_note(data), "", f"One thread, median of {len(next(iter(data['cases'].values()))['times'])} "
-                  "repeats (wall time). An elastic-only scene compiles and launches no return."]
+    n = len(next(iter(data["cases"].values()))["times"])
+    return out + ["", env_note(data), "", f"Threads: {data.get('threads')}; the median of {n} repeats (wall time). "
+                  "An elastic-only scene compiles and launches no return."]
 
 
 # ----------------------------------------------------------------------------- plane strain
@@ -217,8 +218,8 @@ def render_bonded_return(data: dict, ctx) -> list[str]:
             for r in data["rows"]]
     out = table(["trial states", "points", "yielding (bonded / Cam-Clay)", "bonded (ns/point)",
                  "Cam-Clay (ns/point)", "bonded / Cam-Clay"], rows)
-    return out + ["", env_note(data), "", f"{data.get('precision')}, one launch over all points, fastest of "
-                  f"{len(data['rows'][0]['bonded_times_s'])} repeats."]
+    return out + ["", env_note(data), "", f"{data.get('precision')}, one launch over all points: the median of "
+                  f"{len(data['rows'][0]['bonded_times_s'])} launches after a compiling one."]
 
 
 pending("perf", "The Cam-Clay update and its parts", "perf/results/return_cost_cpu.json",
@@ -242,8 +243,10 @@ def render_eig3(data: dict, ctx) -> list[str]:
     out = table(["precision", "matrices", "Jacobi (ns)", "Jacobi max off-diagonal (u)", "Jacobi p99 (u)",
                  "Jacobi non-orthogonality (u)", "eig3 (ns)", "eig3 max off-diagonal (u)", "eig3 p99 (u)",
                  "eig3 non-orthogonality (u)", "Jacobi / eig3 time"], rows)
-    return out + ["", env_note(data), "", "Residuals in units of the precision's round-off (u): the largest and the "
-                  "99th-percentile off-diagonal of V^T A V, and the largest departure of V from orthogonality."]
+    return out + ["", env_note(data), "", f"Median of {len(data['rows'][0]['jacobi']['times_s'])} launches of each, "
+                  "timed alternately after a compiling one. Residuals in units of the precision's round-off (u): "
+                  "the largest and the 99th-percentile off-diagonal of V^T A V, and the largest departure of V from "
+                  "orthogonality."]
 
 
 pending("perf", "CUDA: the device suite", "perf/results/device_suite_cuda.json", "bash benchmarks/device_suite.sh",

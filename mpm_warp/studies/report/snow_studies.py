@@ -39,8 +39,8 @@ def render_wf_sweep(data: dict, ctx) -> list[str]:
                  "deflection front (m/s)", "collapse height (mm)", "Heierli, the run's collapse (m/s)", "wall time"],
                 rows)
     out += ["", env_note(data), "", f"The ladder PST at {_cells(data)} across the layer ({_column(data)}); "
-            f"bisection from {fx(data['bracket'][0], 2)} to {fx(data['bracket'][1], 2)} m to "
-            f"{fx(data['bracket'][2], 2)} m; the base run from the longest cut gives the speed.", ""]
+            f"bisection in [{fx(data['bracket'][0], 2)}, {fx(data['bracket'][1], 2)}] m down to a "
+            f"{fx(data['bracket'][2], 2)} m bracket; the base run from the longest cut gives the speed.", ""]
     ok = [c for c in data["cases"] if c.get("bracketed") and finite(c.get("critical_cut"))]
     if len(ok) >= 2:
         n = loglog_slope([c["w_f"] for c in ok], [c["critical_cut"] for c in ok])
