@@ -4,7 +4,8 @@ Three columns with realistic field parameters (``pst_demo``'s snow unless said, 
 tensile strength and fracture energy from each layer's density, docs/model.md §9):
 
 - ``SF``: a soft, thin slab, 20 cm of new snow (120 kg/m^3, E 0.85 MPa from the density, tensile strength
-  1.7 kPa), on a weak layer of 700 Pa shear strength, a 2 m column sawn to 0.6 m: the slab breaks;
+  1.7 kPa), on a weak layer of 700 Pa shear strength that collapses by a fifth (6 mm of its 3 cm, the "about
+  20 %" of Gaume et al. 2018's shear test), a 2 m column sawn to 0.6 m: the slab breaks;
 - ``END``: ``pst_demo`` itself (0.3 m slab of 250 kg/m^3 at 5 MPa, tensile strength 10 kPa, a 2.5 m
   column sawn to 0.6 m): the crack reaches the far end;
 - ``ARR``: the same slab on a tougher weak layer (fracture energy 1.2 J/m^2, the upper part of the field's
@@ -44,14 +45,16 @@ OUT = "pst_outcomes"
 FIELDS = "output.fields=['x','log_jp','damage']"
 #: the columns: (overrides of pst_demo, slab layers replacing its slab or None, what the case stands for)
 CASES = {
-    "SF": (["scene.length=2.0", "scene.saw.cut_length=0.6", "scene.weak_layer.tau_p=700", "time.end=0.9"],
+    "SF": (["scene.length=2.0", "scene.saw.cut_length=0.6", "scene.weak_layer.tau_p=700", "scene.weak_layer.h_c=0.006",
+            "time.end=0.9"],
            (SnowLayer(0.2, 120.0),), "soft, thin slab: 20 cm of new snow, 120 kg/m^3"),
     "END": (["time.end=0.9"], None, "pst_demo's stiff slab: 0.3 m of 250 kg/m^3 at 5 MPa"),
     "ARR": (["scene.weak_layer.w_f=1.2", "scene.saw.cut_length=0.8", "time.end=1.1"], None,
             "pst_demo's slab on a tougher weak layer (w_f 1.2 J/m^2)"),
 }
 QUICK = (["scene.dx=0.01", "scene.weak_layer_thickness=0.04", "scene.substratum_thickness=0.05", "scene.length=0.8",
-          "scene.saw.cut_length=0.5", "time.end=0.7"], (SnowLayer(0.12, 120.0),), "a 0.8 m column, 12 cm slab")
+          "scene.saw.cut_length=0.5", "time.end=0.7", "scene.weak_layer.h_c=0.008"], (SnowLayer(0.12, 120.0),),
+         "a 0.8 m column, 12 cm slab on a 4 cm layer collapsing by 8 mm")
 
 
 def scenario(overrides, layers) -> mw.Scenario:
