@@ -32,9 +32,10 @@ import sys
 
 from . import convergence, perf, robustness, snow_runs, snow_studies  # noqa: F401  (registration)
 from .core import DOC, SECTIONS, Context, document, pending, section
-from .readme import headlines, with_block
+from .readme import block, headlines, with_block
 
-__all__ = ["SECTIONS", "Context", "section", "pending", "default_root", "results_markdown", "readme_text", "main"]
+__all__ = ["SECTIONS", "Context", "section", "pending", "default_root", "results_markdown", "readme_text", "headlines",
+           "main"]
 
 
 def default_root() -> str:
@@ -54,7 +55,7 @@ def readme_text(root: str | None = None) -> str | None:
     if not os.path.isfile(path):
         return None
     with open(path) as fh:
-        return with_block(fh.read(), headlines(Context(root)))
+        return with_block(fh.read(), block(Context(root)))
 
 
 def _write(path: str, text: str) -> None:

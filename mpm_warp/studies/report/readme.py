@@ -10,10 +10,13 @@ from ..snow import FIELD_SPEED
 from .core import Context, slug
 from .fmt import bracket, finite, fx, ratio_range, spct
 
-__all__ = ["BEGIN", "END", "headlines", "with_block"]
+__all__ = ["BEGIN", "END", "headlines", "block", "with_block"]
 
 BEGIN = "<!-- results:begin -->"
 END = "<!-- results:end -->"
+#: The block's last line, after the bullets.
+WHERE = ("Every measured table, with the command that reproduces it and where it was measured, is in "
+         "[docs/results.md](docs/results.md).")
 
 
 def _link(title: str) -> str:
@@ -84,6 +87,12 @@ def headlines(ctx: Context) -> list[str]:
            _throughput(ctx, "perf/results/throughput_2d_cpu.json", 2, "Throughput beside Taichi, 2D"),
            _pst_speed(ctx), _critical_cut(ctx), _shear(ctx)]
     return [b for b in out if b]
+
+
+def block(ctx: Context) -> list[str]:
+    """The README block's lines: the headline bullets, then where the tables are."""
+    bullets = headlines(ctx)
+    return bullets + ([""] if bullets else []) + [WHERE]
 
 
 def with_block(readme: str, bullets: list[str]) -> str | None:
