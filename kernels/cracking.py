@@ -54,8 +54,19 @@ def crack_func(T, dim):
     eig3 = jacobi_eig3_func(T)
 
     @wp.func
+    def soften(tau: M, pos: M, s1: T, kappa: T, threshold: T, t_strength: T, t_fail: T):
+        """``tau`` less the damage of the grown ``kappa`` times its tensile part ``pos``."""
+        k_new = kappa
+        grew = int(0)
+        if s1 > threshold:
+            k_new = s1
+            grew = 1
+        return tau - damage(k_new, t_strength, t_fail) * pos, k_new, grew
+
+    @wp.func
     def crack(tau: M, kappa: T, t_strength: T, t_fail: T):
         threshold = wp.max(kappa, t_strength)
+        pos = M()
         if wp.static(dim == 2):
             mean = T(0.5) * (tau[0, 0] + tau[1, 1])
             half = T(0.5) * (tau[0, 0] - tau[1, 1])
@@ -64,18 +75,11 @@ def crack_func(T, dim):
             s2 = mean - rad
             if s1 <= threshold and kappa <= t_strength:
                 return tau, kappa, int(0)
-            k_new = kappa
-            grew = int(0)
-            if s1 > threshold:
-                k_new = s1
-                grew = 1
-            d = damage(k_new, t_strength, t_fail)
-            pos = M()
             if s2 >= T(0.0):
                 pos = tau
             elif s1 > T(0.0):       # the tensile principal part s1 n n^T, n n^T = (tau - s2 I) / (s1 - s2)
                 pos = (s1 / (s1 - s2)) * (tau - s2 * wp.identity(2, dtype=T))
-            return tau - d * pos, k_new, grew
+            return soften(tau, pos, s1, kappa, threshold, t_strength, t_fail)
         else:
             bound = tau[0, 0] + wp.abs(tau[0, 1]) + wp.abs(tau[0, 2])
             bound = wp.max(bound, tau[1, 1] + wp.abs(tau[0, 1]) + wp.abs(tau[1, 2]))
@@ -83,19 +87,11 @@ def crack_func(T, dim):
             if bound <= threshold and kappa <= t_strength:
                 return tau, kappa, int(0)
             Q, lam = eig3(tau)
-            s1 = wp.max(lam[0], wp.max(lam[1], lam[2]))
-            k_new = kappa
-            grew = int(0)
-            if s1 > threshold:
-                k_new = s1
-                grew = 1
-            d = damage(k_new, t_strength, t_fail)
-            pos = M()
             for a in range(3):
                 if lam[a] > T(0.0):
                     q = V3(Q[0, a], Q[1, a], Q[2, a])
                     pos = pos + lam[a] * wp.outer(q, q)
-            return tau - d * pos, k_new, grew
+            return soften(tau, pos, wp.max(lam[0], wp.max(lam[1], lam[2])), kappa, threshold, t_strength, t_fail)
 
     return crack
 

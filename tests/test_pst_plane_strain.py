@@ -13,7 +13,9 @@ then the softening layer amplifies round-off: at 0.16 s kappa differs by 4e-4, a
 positions by 3e-7 m (3e-5 dx), log_jp by 5e-5 (of 0.14). The slab's own two layers, identical in exact
 arithmetic, drift apart the same way (2e-8 m by 0.23 s): the difference is amplified round-off, not a
 difference of model. Tolerances: before 0.15 s, round-off (1e-12 relative); after the crack ran, fronts
-and saw identical (measured identical), runaway cut 1e-6 relative (measured 3e-9), collapse height 1e-3
+and saw identical (measured identical), runaway cut two time steps of saw travel (a bin's arrival is the
+median of its particles' step times, which the amplified round-off moves by steps: measured 3e-9 m on one
+build and 3.6e-5 m, 1.5 steps of 24.4 us at 1 m/s, after an ulp-level change of the calibration), collapse height 1e-3
 relative (measured 2e-4 at most), touchdown one front bin (dx; measured 1.9 mm), positions 1e-3 dx and
 log_jp 1e-3 of its range.
 """
@@ -109,7 +111,8 @@ def test_pst_2d_equals_slab():
     np.testing.assert_array_equal(m3.deflection_arrival() == np.inf, m2.deflection_arrival() == np.inf)
     c2, c3 = np.asarray(m2.series["collapse_height"]), np.asarray(m3.series["collapse_height"])
     np.testing.assert_allclose(c3, c2, rtol=0, atol=1e-3 * c2.max())
-    assert r3["runaway_cut"] == pytest.approx(r2["runaway_cut"], rel=1e-6)
+    dt = s2.stepper.clock()[0] / s2.stepper.clock()[2]
+    assert abs(r3["runaway_cut"] - r2["runaway_cut"]) <= 2 * p.saw.speed * dt
     assert abs(r3["touchdown"] - r2["touchdown"]) <= p.bin_width
     # the slab's first particle layer (z fastest in the lattice) against the 2D run, and its two layers
     x2, x3 = s2.state.x.numpy(), s3.state.x.numpy()

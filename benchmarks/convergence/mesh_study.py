@@ -52,11 +52,12 @@ import time
 import numpy as np
 
 import mpm_warp as mw
+from mpm_warp.camclay_forms import oedometric_ratio
 from mpm_warp.materials import hardening_collapse
 from mpm_warp.studies.convergence import observed_order
 from mpm_warp.studies.environment import environment
 from mpm_warp.studies.protocol import out_dir, parser
-from mpm_warp.validation import G, oedometric_collapse, oedometric_ratio, run_column, weak_layer_column
+from mpm_warp.validation import G, oedometric_collapse, run_column, weak_layer_column
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 DEFAULT_CELLS = (2, 4, 8, 16, 32)  # cells across the weak layer: dx = D_wl / cells
