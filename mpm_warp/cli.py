@@ -149,7 +149,21 @@ def cmd_run(a) -> int:
 def cmd_profile(a) -> int:
     from .scenes.profile import read_profile
 
-    print(read_profile(a.file).summary())
+    data = read_profile(a.file)
+    print(data.summary())
+    if data.pst_tests:
+        from .scenes.pst.field_inversion import field_fracture_energy
+
+        for t in data.pst_tests:
+            r = field_fracture_energy(a.file, t)
+            if "G" not in r:
+                print(f"  {r['note']}")
+                continue
+            p = r["params"]
+            print(f"  weac: G = {r['G']:.3g} J/m^2 (G_I {r['G_I']:.2g}, G_II {r['G_II']:.2g}) at the cut of "
+                  f"{t.cut_length * 100:.0f} cm: the weak layer's fracture energy this test implies (weak layer "
+                  f"E {p.weak_layer.E / 1e6:g} MPa, nu {p.weak_layer.nu:g}, cut from {p.saw.cut_from}, "
+                  f"{p.column_ends.replace('_', '-')} ends)")
     return 0
 
 

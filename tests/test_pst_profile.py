@@ -91,3 +91,21 @@ def test_from_python_a_profile_is_a_scene_table():
     table = pst.expand_profile({"kind": "pst", "profile": {"file": str(example_path()), "weak_layer_index": 2}})
     assert len(table["slab_layers"]) == 2 and table["slope_angle"] == 35.0
     assert pst.expand_profile({"kind": "pst"}) == {"kind": "pst"}         # no profile: unchanged
+
+
+def test_a_field_pst_read_backwards_gives_the_fracture_energy_that_reproduces_its_cut(capsys):
+    """The profile's PST 32/100: weac's G at 32 cm is the fracture energy, and weac's critical cut with that
+    G_c is 32 cm again (the round trip closes to the root finder's tolerance); the CLI prints it."""
+    from mpm_warp.scenes.profile import read_profile
+    from mpm_warp.scenes.pst.field_inversion import field_fracture_energy
+    from mpm_warp.scenes.pst.static import static_column
+    from mpm_warp.scenes.weac_reference import critical_cut_search
+
+    (rec,) = read_profile(example_path()).pst_tests
+    r = field_fracture_energy(example_path(), rec)
+    assert r["cut"] == 0.32 and r["params"].length == 1.0 and r["params"].slope_angle == 35.0
+    assert r["G"] == pytest.approx(r["G_I"] + r["G_II"], rel=1e-12)
+    assert 0.05 < r["G"] < 0.15  # measured 0.0778 J/m^2 (weak layer E 1 MPa, a stiff wind slab above)
+    assert critical_cut_search(static_column(r["params"]), r["G"]).value == pytest.approx(0.32, abs=1e-9)
+    assert main(["profile", example_path()]) == 0
+    assert f"weac: G = {r['G']:.3g} J/m^2" in capsys.readouterr().out
