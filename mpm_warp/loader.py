@@ -321,7 +321,7 @@ def read_scenario_dict(path_or_name: str) -> tuple[dict, str]:
         raise ScenarioError(f"{path}: is a directory, not a scenario file")
     try:
         with open(path, "rb") as fh:
-            return tomllib.load(fh), path
+            raw = tomllib.load(fh)
     except tomllib.TOMLDecodeError as e:
         raise ScenarioError(f"{path}: not valid TOML: {e}") from None
     except UnicodeDecodeError as e:
@@ -332,6 +332,26 @@ def read_scenario_dict(path_or_name: str) -> tuple[dict, str]:
         raise ScenarioError(f"{path}: not valid TOML for a scenario: arrays or tables nested too deeply") from None
     except OSError as e:
         raise ScenarioError(f"{path}: cannot be read ({e.strerror})") from None
+    if _nesting(raw) > MAX_NESTING:
+        raise ScenarioError(f"{path}: not valid TOML for a scenario: arrays or tables nested too deeply "
+                            f"(more than {MAX_NESTING} levels; a scenario needs 4)")
+    return raw, path
+
+
+#: the deepest nesting of arrays and tables a scenario file may have (a scenario needs 4)
+MAX_NESTING = 16
+
+
+def _nesting(obj) -> int:
+    """How deeply arrays and tables nest in ``obj`` (0 for a scalar), without recursion."""
+    deepest, stack = 0, [(obj, 0)]
+    while stack:
+        node, depth = stack.pop()
+        if isinstance(node, dict | list):
+            depth += 1
+            deepest = max(deepest, depth)
+            stack.extend((v, depth) for v in (node.values() if isinstance(node, dict) else node))
+    return deepest
 
 
 def load_scenario(path_or_name, overrides=None) -> Scenario:

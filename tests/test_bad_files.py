@@ -64,6 +64,11 @@ def _case_nested(made, tmp):
     return ["run", str(tmp / "s.toml")], ("nested too deeply",)
 
 
+def _case_nested_16(made, tmp):  # too deep for a scenario, far from Python's recursion limit
+    (tmp / "s.toml").write_text(sub("lo = [0.1, 0.02, 0.0]", "lo = " + "[" * 16 + "0.1" + "]" * 16))
+    return ["run", str(tmp / "s.toml")], ("nested too deeply", "more than 16 levels")
+
+
 def _case_scenario_dir(made, tmp):
     return ["run", str(tmp)], ("is a directory",)
 
@@ -192,6 +197,7 @@ def _damaged(command, how):
 
 FILE_CASES = [
     ("binary-scenario", _case_binary), ("utf16-scenario", _case_utf16), ("nested-500", _case_nested),
+    ("nested-16-arrays", _case_nested_16),
     ("scenario-is-directory", _case_scenario_dir), ("scenario-fifo", _case_scenario_fifo),
     ("scenario-device", _case_scenario_device), ("scenario-socket", _case_scenario_socket),
     ("out-is-directory", _case_out_dir),
