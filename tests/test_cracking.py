@@ -138,3 +138,30 @@ def test_plane_strain_softens_the_in_plane_stress_as_3d_does():
     assert a["damage"][0, -1] == 1.0 and b["damage"][0, -1] == 1.0
     np.testing.assert_allclose(b["stress"][0, :, 0, 0], a["stress"][0, :, 0, 0], rtol=1e-6, atol=1e-6 * ST)
     np.testing.assert_allclose(b["damage"][0], a["damage"][0], rtol=1e-9, atol=1e-12)
+
+
+def test_a_slab_that_cannot_break_launches_and_allocates_nothing_of_cracking():
+    """Leave-out: the homogeneous PST without ``slab_fracture`` launches the same kernels as before the
+    feature existed (no P2G kernel of the cracking model), holds kappa for the weak layer only and writes no
+    damage field; with it, the slab's P2G launches are the cracking ones and nothing else changes."""
+    from helpers_scenes import TINY_PST
+
+    from mpm_warp.loader import load_scenario
+
+    def sim(extra):
+        return mw.Simulation(load_scenario("pst_demo", TINY_PST + extra), device="cpu", n_threads=1)
+
+    off, on = sim([]), sim(["scene.slab_fracture=true"])
+    models = {g.name: g.material.model for g in off.model.groups}
+    assert "tensile_cracking" not in models.values() and models["slab"] == "elastic"
+    assert {g.name: g.material.model for g in on.model.groups}["slab"] == "tensile_cracking"
+    weak = [g for g in off.model.groups if g.material.model == "bonded_camclay"]
+    assert off.state.kappa.shape[0] == sum(g.count for g in weak) < off.model.n_particles
+    assert "damage" not in off.scenario.output.fields
+    k_off = [launch.kernel for launch in off.stepper.launches]
+    k_on = [launch.kernel for launch in on.stepper.launches]
+    assert len(k_off) == len(k_on)
+    differ = [(a, b) for a, b in zip(k_off, k_on, strict=True) if a is not b]
+    assert len(differ) == 1 and differ[0][0].key == differ[0][1].key == "p2g_kernel__locals__p2g"  # the slab's P2G
+    cracking_kernels = {b for _, b in differ}
+    assert not cracking_kernels & set(k_off)
