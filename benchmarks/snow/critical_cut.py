@@ -3,7 +3,7 @@
 Each case bisects :func:`mpm_warp.scenes.pst.critical_cut` on a PST column (trial runs forked from
 one base run, :mod:`mpm_warp.scenes.pst.critical`) and writes ``benchmarks/snow/results/snow_critical_cut.json``
 (one entry per case, merged into what is there) and ``snow_critical_cut.png`` (the trials: cut
-against outcome, with the bracket, beside Gaume et al. 2017's formula):
+against outcome, with the bracket, beside Gaume et al. 2017's formula and weac's static critical cut):
 
 - ``flat``: ``pst_flat`` on a 3 m column;
 - ``slope``: ``pst_slope`` (30 deg) on a 3 m column;
@@ -14,8 +14,8 @@ against outcome, with the bracket, beside Gaume et al. 2017's formula):
   that ladder's next level.
 - ``ladder_slope``: that PST on a 30 deg slope (``pst_slope``'s angle), the saw cutting from the
   upslope end (the crack runs downslope);
-- ``ladder_slope_cut_downslope_end``: the same with the slope reversed (-30 deg): the saw cuts from the
-  downslope end and the crack runs upslope.
+- ``ladder_slope_cut_downslope_end``: the same with the saw cutting from the downslope end
+  (``saw.cut_from = "downslope"``): the crack runs upslope.
 
 Usage::
 
@@ -34,6 +34,7 @@ import time
 
 import mpm_warp as mw
 from mpm_warp.scenes.pst import critical_cut
+from mpm_warp.scenes.pst.static import weac_answer
 from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -53,7 +54,7 @@ CASES = {
     "flat_saw_half": ("pst_flat", COLUMN + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.8, tol=0.02)),
     "ladder_saw_half": ("pst_flat", LADDER + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.7, tol=0.02)),
     "ladder_slope": ("pst_slope", LADDER, dict(lo=0.05, hi=0.7, tol=0.02)),
-    "ladder_slope_cut_downslope_end": ("pst_slope", LADDER + ["scene.slope_angle=-30.0"],
+    "ladder_slope_cut_downslope_end": ("pst_slope", LADDER + ["scene.saw.cut_from='downslope'"],
                                        dict(lo=0.05, hi=0.7, tol=0.02)),
 }
 #: --quick: the ladder PST on a 1.2 m column bisected once (bracket [0.1, 0.5] m to 0.25 m: the base run, 2 trials)
@@ -96,29 +97,57 @@ def ladder_rows() -> dict:
             if lv.get("bisection", {}).get("narrowed_from"):
                 label = label[:-1] + ", narrowed)"
             out[label] = {"trials": lv["trials"], "lo": lo, "hi": hi,
-                          "gaume": sc.scene.references(stored_calibration(sc)).get("critical_cut_gaume")}
+                          "gaume": sc.scene.references(stored_calibration(sc)).get("critical_cut_gaume"),
+                          "weac": weac_cut(sc)}
     return out
+
+
+def weac_cut(sc) -> float | None:
+    """weac's static critical cut (m) of the scenario's column (:mod:`mpm_warp.scenes.pst.static`), or None."""
+    answer = weac_answer(sc.scene, stored_calibration(sc))
+    return answer.get("critical_cut")
+
+
+def case_weac(c: dict) -> float | None:
+    """A case's weac critical cut: stored with it, else computed for its column (older JSON, whose slope sign
+    still named the saw's end: a negative angle was the cut from the downslope end)."""
+    if "weac" not in c and "scene" in c:
+        c = {**c, "overrides": [o.replace("scene.slope_angle=-30.0", "scene.saw.cut_from='downslope'")
+                                for o in c["overrides"]]}
+        c["weac"] = weac_cut(mw.load_scenario(c["scene"], c["overrides"]))
+    w = c.get("weac")
+    return w.get("critical_cut") if isinstance(w, dict) else w
 
 
 def figure(data: dict, path: str) -> None:
     """Every case's trials (and the ladder PST's own bisections, its references), bracket and Gaume's value."""
     plt = _plt()
     cases = {**ladder_rows(), **data["cases"]}
-    fig, ax = plt.subplots(figsize=(9, 1.3 + 0.55 * len(cases)))
+    fig, ax = plt.subplots(figsize=(9, 2.0 + 0.55 * len(cases)))
     for i, c in enumerate(cases.values()):
         for tr in c["trials"]:
             ax.plot(tr["cut"], i, "o" if tr["propagated"] else "x", color="C3" if tr["propagated"] else "C0", ms=7)
         ax.plot([c["lo"], c["hi"]], [i, i], "-", color="k", lw=3, alpha=0.4)
         if c.get("gaume") is not None:
             ax.plot(c["gaume"], i, "D", color="C2", ms=7, mfc="none")
+        w = case_weac(c)
+        if w is not None:
+            ax.plot(w, i, "*", color="C1", ms=11)
     ax.axvspan(*FIELD_CUT, color="0.9", zorder=0)
     labels = {"flat": "pst_flat (3 m column, 4 cells)", "slope": "pst_slope (3 m column, 4 cells)",
               "flat_saw_half": "pst_flat, saw 0.5 m/s", "ladder_saw_half": "ladder, saw 0.5 m/s",
               "ladder_slope": "ladder, 30 deg, cut from the upslope end",
               "ladder_slope_cut_downslope_end": "ladder, 30 deg, cut from the downslope end"}
     ax.set_yticks(range(len(cases)), [labels.get(k, k) for k in cases])
-    ax.set(xlabel="saw cut length [m]", title="critical cut: x arrested, o propagated, bar = bracket,\n"
-                                             "diamond = Gaume et al. 2017 (flat formula), grey = 0.15-0.6 m")
+    ax.set(xlabel="saw cut length [m]", title="PST critical cut: the bisections' trials and brackets")
+    key = [ax.plot([], [], "x", color="C0", ms=7, label="trial: arrested")[0],
+           ax.plot([], [], "o", color="C3", ms=7, label="trial: propagated")[0],
+           ax.plot([], [], "-", color="k", lw=3, alpha=0.4, label="bracket")[0],
+           ax.plot([], [], "*", color="C1", ms=11, label="weac (static, G = w_f)")[0],
+           ax.plot([], [], "D", color="C2", ms=7, mfc="none", label="Gaume et al. 2017 (flat formula)")[0]]
+    ax.legend(handles=key, loc="upper center", bbox_to_anchor=(0.5, -0.12 - 0.3 / len(cases)), ncol=3,
+              fontsize=8, frameon=False, title=f"grey: the field's {FIELD_CUT[0]:g}-{FIELD_CUT[1]:g} m",
+              title_fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
@@ -149,6 +178,7 @@ def run_case(name: str, data: dict, device: str) -> dict:
            "hi": res.hi, "trials": res.trials, "runaway_cut_of_base": res.runaway_cut, "wall_s": wall,
            "dx": sc.scene.dx, "saw_speed": sc.scene.saw.speed, "slope_angle": sc.scene.slope_angle,
            "gaume": refs.get("critical_cut_gaume"),
+           "weac": res.weac, "classes": res.classes,
            "base_speed_mean": res.base.get("damage_speed_mean"), "base_propagated": res.base.get("propagated"),
            "environment": environment(device)}
     print(f"{name}: critical cut in [{res.lo:.3f}, {res.hi:.3f}] m ({wall:.0f} s) {res.note}", flush=True)
