@@ -127,6 +127,13 @@ def test_older_left_right_saw_ends_name_the_same_end(end, slope, want):
     assert p.cut_at_origin == (end == "left")
 
 
+def test_a_negative_slope_without_the_saws_end_is_refused_in_files():
+    """A negative angle once named the saw's end (from the downslope end); a file must now say which end."""
+    with pytest.raises(InvalidArgument, match=r"scene.slope_angle = -30.0 .*cut_from = 'upslope' \| 'downslope'"):
+        upgrade_table({"slope_angle": -30.0, "saw": {"speed": 1.0}})
+    assert upgrade_table({"slope_angle": -30.0, "saw": {"cut_from": "downslope"}})["saw"] == {"cut_from": "downslope"}
+
+
 def test_cut_from_names_the_physical_end_on_either_slope():
     for slope, origin_is_up in ((30.0, True), (-30.0, False), (0.0, True)):
         up = pst.PSTParams(slope_angle=slope, saw=pst.Saw(cut_from="upslope"))
