@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from ..errors import InvalidArgument
 
-__all__ = ["LADDER_PST", "PST_DX", "PST_BRACKET", "SHEAR_CELLS", "FIELD_SPEED", "FIELD_CUT",
+__all__ = ["LADDER_PST", "PST_DX", "PST_BRACKET", "SHEAR_CELLS", "FIELD_SPEED", "LONG_PST_SPEED", "DEM_STEADY_MAX",
+           "SUPERSHEAR_MAX", "STEADY_FROM", "FIELD_CUT",
            "PST_CUT_FIELDS", "ladder_pst", "grid_bracket", "pst_part", "merge_pst_parts"]
 
 #: Scenario overrides of ``pst_flat`` that make the ladder PST (module docstring).
@@ -23,8 +24,16 @@ PST_DX = (0.02, 0.01, 0.005, 0.0025)
 PST_BRACKET = {"lo": 0.1, "hi": 0.7, "tol": 0.02}
 #: The shear-test ladder's cells across its 3 cm layer.
 SHEAR_CELLS = (3, 6, 12, 24)
-#: PST crack speeds in the field (m/s; Bergfeld et al. 2021, docs/model.md §6).
+#: PST crack speeds in the field (m/s) over the first metres, in short PSTs (Bergfeld et al. 2021, docs/model.md §6).
 FIELD_SPEED = (20.0, 30.0)
+#: Crack speeds in long PSTs and slope-scale measurements (m/s; Bergfeld et al. 2022, docs/model.md §6).
+LONG_PST_SPEED = (36.0, 49.0)
+#: The largest steady speed of long flat DEM PSTs, as a fraction of the slab's c_s (Bobillier et al. 2024).
+DEM_STEADY_MAX = 0.6
+#: The fastest cracks on steep slopes, as a fraction of c_s (Trottet et al. 2022; Bobillier et al. 2025).
+SUPERSHEAR_MAX = 1.6
+#: Where a long column's crack is steady (m from the cut end): beyond about 5 m of propagation.
+STEADY_FROM = 5.0
 #: Critical cuts of a flat PST in the field (m): a few tens of centimetres.
 FIELD_CUT = (0.15, 0.6)
 #: What a narrowed critical-cut search adds to a level's base-run record (:func:`merge_pst_parts`).

@@ -6,9 +6,10 @@ left alone.
 
 from __future__ import annotations
 
-from ..snow import FIELD_SPEED
+from ..snow import DEM_STEADY_MAX, FIELD_SPEED, LONG_PST_SPEED, STEADY_FROM
 from .core import Context, slug
 from .fmt import bracket, finite, fx, ratio_range, spct
+from .snow_runs import steady_speed
 
 __all__ = ["BEGIN", "END", "headlines", "block", "with_block"]
 
@@ -43,12 +44,36 @@ def _pst_speed(ctx: Context) -> str | None:
     r = data["result"]
     v = r.get("damage_speed_mean")
     a, b = r.get("damage_speed_mean_over") or (None, None)
-    if not finite(v):
+    steady, cs = steady_speed(r, data.get("scene_slab_thickness") or 0.0), r.get("shear_wave_speed")
+    if not finite(v) or steady is None or not finite(cs):
         return None
-    where = "inside" if FIELD_SPEED[0] <= v <= FIELD_SPEED[1] else "outside"
-    return (f"- **PST crack speed:** `pst_flat`'s crack runs at {fx(v, 1)} m/s on average from {fx(a, 1)} to "
-            f"{fx(b, 1)} m, {where} the field's {FIELD_SPEED[0]:g}-{FIELD_SPEED[1]:g} m/s "
+
+    def where(x, band):
+        return "inside" if band[0] <= x <= band[1] else "outside"
+    return (f"- **PST crack speed:** on `pst_flat`'s 8 m column the crack settles at {fx(steady, 1)} m/s "
+            f"({steady / cs:.2f} c_s) beyond {STEADY_FROM:g} m, {where(steady, LONG_PST_SPEED)} the "
+            f"{LONG_PST_SPEED[0]:g}-{LONG_PST_SPEED[1]:g} m/s of long PSTs (Bergfeld et al. 2022) and "
+            f"{'below' if steady / cs <= DEM_STEADY_MAX else 'above'} the {DEM_STEADY_MAX:g} c_s of long DEM PSTs "
+            f"(Bobillier et al. 2024); over {fx(a, 1)}-{fx(b, 1)} m it averages {fx(v, 1)} m/s, "
+            f"{where(v, FIELD_SPEED)} short PSTs' {FIELD_SPEED[0]:g}-{FIELD_SPEED[1]:g} m/s "
             f"([PST: `pst_flat`]({_link('PST: `pst_flat`')})).")
+
+
+def _slope(ctx: Context) -> str | None:
+    cuts = (ctx.load("snow/results/snow_critical_cut.json") or {}).get("cases") or {}
+    weac = (ctx.load("snow/results/weac_static_pst.json") or {}).get("ladder") or {}
+    flat = [r for r in ((ctx.load("convergence/results/error_vs_runtime_snow.json") or {}).get("ladders") or {})
+            .get("pst", []) if r.get("level") == 1 and r["precision"] == "float32" and r.get("bracketed")]
+    up, down = cuts.get("ladder_slope"), cuts.get("ladder_slope_cut_downslope_end")
+    w = {k: (weac.get(k) or {}).get("critical_cut") for k in ("flat", "upslope_30", "downslope_30")}
+    if not (flat and up and down and all(finite(x) for x in w.values())):
+        return None
+    a0 = flat[0]["critical_cut"]
+    title = "Critical cut"
+    return (f"- **Slope:** on 30 deg the critical cut from the upslope end is {spct(up['value'] / a0 - 1)} and from "
+            f"the downslope end {spct(down['value'] / a0 - 1)} of the flat column's, against weac's "
+            f"{spct(w['upslope_30'] / w['flat'] - 1)} and {spct(w['downslope_30'] / w['flat'] - 1)} for the "
+            f"same columns: the cut end decides, as the static reference says ([{title}]({_link(title)})).")
 
 
 def _critical_cut(ctx: Context) -> str | None:
@@ -85,7 +110,7 @@ def headlines(ctx: Context) -> list[str]:
     """The README's headline bullets (a bullet whose results are not committed is left out)."""
     out = [_throughput(ctx, "perf/results/throughput_cpu.json", 3, "Throughput beside Taichi, 3D"),
            _throughput(ctx, "perf/results/throughput_2d_cpu.json", 2, "Throughput beside Taichi, 2D"),
-           _pst_speed(ctx), _critical_cut(ctx), _shear(ctx)]
+           _pst_speed(ctx), _critical_cut(ctx), _slope(ctx), _shear(ctx)]
     return [b for b in out if b]
 
 

@@ -6,7 +6,8 @@ from __future__ import annotations
 import math
 
 from ...scenes.pst.analysis import SPEED_LIMIT_DISTANCE, SPEED_WINDOW
-from ..snow import FIELD_CUT, FIELD_SPEED, LADDER_PST
+from .. import snow as refs
+from ..snow import DEM_STEADY_MAX, FIELD_CUT, FIELD_SPEED, LADDER_PST, LONG_PST_SPEED, STEADY_FROM
 from .core import section
 from .fmt import DASH, bracket, count, env_note, finite, fx, secs, spct, table
 
@@ -30,6 +31,28 @@ def speed_profile_summary(res: dict, prefix: str) -> dict:
     return out
 
 
+def steady_speed(res: dict, slab_thickness: float, prefix: str = "damage") -> float | None:
+    """The median local speed (m/s) of one front's windows beyond :data:`~mpm_warp.studies.snow.STEADY_FROM` and
+    before the far end zone (one slab thickness); None on a column too short for it."""
+    prof = res.get(f"{prefix}_speed_profile") or {"s": [], "speed": []}
+    end = (res.get("column_length") or 0.0) - slab_thickness
+    v = sorted(v for s, v in zip(prof["s"], prof["speed"], strict=True) if STEADY_FROM <= s <= end and finite(v))
+    if not v:
+        return None
+    n = len(v)
+    return v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2])
+
+
+def _steady_row(res: dict, slab_thickness: float, slope: float) -> list[str]:
+    v, cs = steady_speed(res, slab_thickness), res.get("shear_wave_speed")
+    text = DASH if v is None else fx(v, 1, unit="m/s") + (f" ({v / cs:.2f} c_s)" if finite(cs) else "")
+    ref = (f"long PSTs and slope scale {LONG_PST_SPEED[0]:g}-{LONG_PST_SPEED[1]:g} m/s (Bergfeld et al. 2022); "
+           f"long flat DEM PSTs at most {DEM_STEADY_MAX:g} c_s (Bobillier et al. 2024)") if not slope else (
+           f"steep slopes: supershear, up to about {refs.SUPERSHEAR_MAX:g} c_s, beyond about {STEADY_FROM:g} m "
+           "(Trottet et al. 2022; Bobillier et al. 2025)")
+    return [f"steady speed of the damage front (median of the windows beyond {STEADY_FROM:g} m)", text, ref]
+
+
 def _profile_text(res: dict, prefix: str) -> str:
     p = speed_profile_summary(res, prefix)
     if p["max"] is None:
@@ -50,7 +73,8 @@ def render_pst(data: dict, ctx) -> list[str]:
         ["particles; steps; wall time", f"{count(data['particles'])}; {count(data['steps'])}; {secs(data['wall_s'])}"
          + (" (resumed once)" if data.get("resumed") else ""), ""],
         [f"crack speed (damage front), mean over {fx(a, 1)}-{fx(b, 1)} m", fx(r["damage_speed_mean"], 1, unit="m/s"),
-         f"field {FIELD_SPEED[0]:g}-{FIELD_SPEED[1]:g} m/s; Heierli {fx(r.get('heierli_speed_run'), 1)} m/s "
+         f"short field PSTs {FIELD_SPEED[0]:g}-{FIELD_SPEED[1]:g} m/s (Bergfeld et al. 2021); "
+         f"Heierli {fx(r.get('heierli_speed_run'), 1)} m/s "
          f"(the run's collapse) / {fx(r.get('heierli_speed'), 1)} m/s (calibrated h_c)"],
         ["deflection front, the same mean", fx(r["deflection_speed_mean"], 1, unit="m/s"),
          f"ratio to the damage front {fx(r.get('front_agreement'), 3)}"],
@@ -58,6 +82,7 @@ def render_pst(data: dict, ctx) -> list[str]:
          "of the cut)", _profile_text(r, "damage"),
          f"c_s {fx(r.get('shear_wave_speed'), 1)} m/s, c_R {fx(r.get('rayleigh_speed'), 1)} m/s"],
         ["local speed of the deflection front", _profile_text(r, "deflection"), ""],
+        _steady_row(r, data.get("scene_slab_thickness") or 0.0, given.get("slope_angle") or 0.0),
         ["first window faster than c_s", f"{sup[1]:.1f} m/s at {sup[0]:.2f} m" if sup else "none", ""],
         ["saw position when the crack leaves it", fx(r.get("runaway_cut"), 3, unit="m"),
          f"Gaume et al. 2017 critical cut {fx(r.get('critical_cut_gaume'), 3)} m"],
