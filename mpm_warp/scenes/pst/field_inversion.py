@@ -9,9 +9,10 @@ table would be (:func:`~.from_profile.expand_profile`), with the weak layer's ot
 
 from __future__ import annotations
 
+import dataclasses
 import os
 
-from ...loader import from_table
+from ..snowpack import SnowLayer
 from .from_profile import expand_profile
 from .params import PSTParams
 from .static import static_column
@@ -19,7 +20,7 @@ from .static import static_column
 __all__ = ["field_fracture_energy"]
 
 
-def field_fracture_energy(profile_file: str, record, scene: dict | None = None) -> dict:
+def field_fracture_energy(profile_file: str, record, params: PSTParams | None = None) -> dict:
     """weac's energy release rate of a recorded PST's column at its critical cut.
 
     Parameters
@@ -28,9 +29,10 @@ def field_fracture_energy(profile_file: str, record, scene: dict | None = None) 
         The CAAML profile the record comes from.
     record : PSTRecord
         The PST (its cut length, column length and depth; :mod:`mpm_warp.scenes.profile`).
-    scene : dict, optional
-        ``[scene]`` entries beside the profile (``weak_layer``, ``column_ends``, ``saw.cut_from``, ...); the
-        defaults of :class:`~.params.PSTParams` otherwise.
+    params : PSTParams, optional
+        What the profile does not give: the weak layer's E and nu, ``column_ends``, ``saw.cut_from``; the
+        defaults of :class:`~.params.PSTParams` otherwise. Its slab, weak layer thickness, substratum, length,
+        slope and cut are the profile's and the record's.
 
     Returns
     -------
@@ -44,12 +46,18 @@ def field_fracture_energy(profile_file: str, record, scene: dict | None = None) 
         return {"note": f"{record.field_line()}: no depth or column length recorded, nothing to read back"}
     if weac_unavailable() is not None:
         return {"note": weac_unavailable()}
-    table = dict(scene or {})
-    table["profile"] = {"file": os.path.abspath(profile_file), "weak_layer_depth": float(record.depth)}
-    table["length"] = float(record.column_length)
-    table["saw"] = {**table.get("saw", {}), "cut_length": float(record.cut_length)}
-    table = expand_profile(table)
-    table.setdefault("dx", table["weak_layer_thickness"] / 4.0)  # weac needs no grid; any that resolves the layer
-    params = from_table(PSTParams, table, "scene").validate("scene")
-    G, G_I, G_II = energy_release_rate(static_column(params), float(record.cut_length))
-    return {"G": G, "G_I": G_I, "G_II": G_II, "cut": float(record.cut_length), "params": params}
+    base = params if params is not None else PSTParams()
+    table = expand_profile({"profile": {"file": os.path.abspath(profile_file), "weak_layer_depth": float(record.depth)},
+                            "substratum_thickness": base.substratum_thickness})
+    weak = base.weak_layer
+    if "density" in table.get("weak_layer", {}):
+        weak = dataclasses.replace(weak, density=table["weak_layer"]["density"])
+    column = dataclasses.replace(
+        base, slab_layers=tuple(SnowLayer(**ly) for ly in table["slab_layers"]),
+        substratum_layers=tuple(SnowLayer(**ly) for ly in table.get("substratum_layers", ())),
+        weak_layer_thickness=table["weak_layer_thickness"], weak_layer=weak, slope_angle=table["slope_angle"],
+        length=float(record.column_length), dx=table["weak_layer_thickness"] / 4.0,   # weac needs no grid
+        saw=dataclasses.replace(base.saw, cut_length=float(record.cut_length)), profile=base.profile)
+    column = column.validate("scene")
+    G, G_I, G_II = energy_release_rate(static_column(column), float(record.cut_length))
+    return {"G": G, "G_I": G_I, "G_II": G_II, "cut": float(record.cut_length), "params": column}
