@@ -64,8 +64,9 @@ BUDGETS = {"tests": (120, 60), "graph": (25, 40), "graph_deterministic": (25, 40
 PARTS = tuple(BUDGETS)
 #: Device-meaningful test modules, most telling first; the second group compares runs bit for bit.
 TEST_MODULES = ("test_transfer", "test_camclay", "test_camclay_large_strain", "test_bonded_camclay",
-                "test_bonded_camclay_driver", "test_cracking", "test_elasticity", "test_walls", "test_stability",
-                "test_validation_api", "test_validation_elastic", "test_weak_layer")
+                "test_bonded_camclay_driver", "test_cracking", "test_elasticity", "test_walls",
+                "test_stability_time_step", "test_stability_contrast", "test_stability_impact",
+                "test_stability_singular_F", "test_validation_api", "test_validation_elastic", "test_weak_layer")
 BITWISE_TEST_MODULES = ("test_graph_batching", "test_resume")
 QUICK_TEST_MODULES = ("test_elasticity", "test_graph_batching")
 
