@@ -19,7 +19,8 @@ from . import checks, frames, io, snapshot
 from .config import Scenario
 from .device import resolve_device
 from .errors import InvalidArgument, MPMError, SimulationBlowUp
-from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, health_zz_kernel, stress_kernel
+from .health import MAX_CELLS_PER_STEP, check_health  # noqa: F401
+from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, health_zz_kernel, stress_kernel  # noqa: F401
 from .memory import check_memory
 from .model import Model, ParticleGroup, State, material_params
 from .monitor import GroupState, Monitor
@@ -28,9 +29,7 @@ from .step import Stepper
 from .time_step import run_times
 
 __all__ = ["Simulation"]
-
-#: a particle may not move more than this many cells in one step (health check)
-MAX_CELLS_PER_STEP = 1.0
+# MAX_CELLS_PER_STEP and the health kernels (the health check is in .health) stay importable from here
 
 
 class Simulation:
@@ -196,34 +195,8 @@ class Simulation:
             logging.getLogger("mpm_warp").warning(f"{writer.path}: the outcome attribute was not stored ({e})")
 
     def health(self) -> None:
-        """Run the device health check; raise SimulationBlowUp on failure."""
-        self._bad.fill_(INT_MAX)
-        s = self.state
-        T = self.model.T
-        wp.launch(health_kernel(self.model.dim, T), self.model.n_particles,
-                  inputs=[s.x, s.v, s.H, s.clock, T(self.model.dx), T(MAX_CELLS_PER_STEP), self._bad],
-                  device=self.device)
-        if s.hzz is not None:
-            for g in self.model.groups:
-                if g.plastic_start >= 0:
-                    wp.launch(health_zz_kernel(T), g.count, inputs=[self._hzz_of(g), g.start, self._bad],
-                              device=self.device)
-        bad = self._bad.numpy()
-        causes = [("x/v/F", "non-finite value (NaN or Inf)"),
-                  ("v", f"moved more than {MAX_CELLS_PER_STEP:g} cell in one step (|v| dt > dx): "
-                        "time step too large for this speed; lower time.cfl or time.dt")]
-        for k, (fld, cause) in enumerate(causes):
-            if bad[k] != INT_MAX:
-                t, dt, steps = self.stepper.clock()
-                raise SimulationBlowUp(steps, int(bad[k]), fld, f"{cause} at t = {t:.6g} s")
-        if self.scenario.output.on_inversion == "stop":
-            floors, inversions = self.stepper.deformation_events()
-            if floors or inversions:
-                t, dt, steps = self.stepper.clock()
-                raise SimulationBlowUp(steps, -1, "F", (
-                    f"{inversions} inversion{'s' * (inversions != 1)} (det F_tr <= 0) and {floors} singular-value "
-                    f"floor event{'s' * (floors != 1)} by t = {t:.6g} s (output.on_inversion = 'stop'; 'report' "
-                    "runs on and counts them)"))
+        """Run the device health check (:func:`mpm_warp.health.check_health`); raise SimulationBlowUp on failure."""
+        check_health(self, self._bad)
 
     def step_to(self, t_end: float, health_every: int | None = None) -> int:
         """Advance to ``t_end`` (s) exactly; return the steps taken.
