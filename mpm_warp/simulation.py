@@ -46,7 +46,7 @@ class Simulation:
     n_threads : int or None
         CPU threads for the step (default: all cores for scenes of 20k particles
         or more; ``MPM_WARP_THREADS`` overrides). Results depend on the thread
-        count at round-off level only (the order grid copies are summed in).
+        count at round-off level only (the order grid copies are summed in). Ignored on CUDA.
     max_memory : int, str or None
         Refuse a scenario whose memory estimate exceeds this (bytes, or e.g. ``"16G"``); the
         machine's available memory is always a limit (:func:`mpm_warp.memory.check_memory`).

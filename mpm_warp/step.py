@@ -38,7 +38,9 @@ def default_threads(device: str, n_particles: int) -> int:
 
 def grid_copies(device: str, n_particles: int, grid_shape, n_threads: int | None = None) -> int:
     """Threads of the CPU step, one grid copy each: :func:`default_threads` (or ``n_threads``), at most one per
-    3 grid slabs along x and per 1000 particles; 1 on CUDA."""
+    3 grid slabs along x and per 1000 particles; 1 on CUDA, whatever ``n_threads`` says."""
+    if wp.get_device(device).is_cuda:
+        return 1
     nt = n_threads or default_threads(device, n_particles)
     return max(1, min(nt, grid_shape[0] // 3, max(1, n_particles // 1000)))
 
@@ -65,7 +67,7 @@ class Stepper:
     use_graph : bool or None
         Capture a batch of steps as a CUDA graph (default: on CUDA only).
     n_threads : int or None
-        CPU threads (default :func:`default_threads`; ``MPM_WARP_THREADS`` overrides).
+        CPU threads (default :func:`default_threads`; ``MPM_WARP_THREADS`` overrides); ignored on CUDA.
     """
 
     def __init__(self, model: Model, state: State, use_graph: bool | None = None, n_threads: int | None = None):
