@@ -19,8 +19,8 @@ the CPU in seconds, as ``tests/test_device_suite.py`` does in CI):
 
 ``tests``
     The device-parametrised test modules with ``MPM_WARP_TEST_DEVICE`` set to
-    the device, one pytest run per module (the modules comparing two runs bit
-    for bit, graph batching and resume, with ``MPM_WARP_TEST_DETERMINISTIC=1``
+    the device, one pytest run per module (the modules comparing runs bit for
+    bit, graph batching, resume, test_cuda_paths' guarded capture, with ``MPM_WARP_TEST_DETERMINISTIC=1``
     on CUDA, where float atomics are otherwise unordered).
 ``graph`` / ``graph_deterministic``
     The struck Cam-Clay block stepped eagerly and through a captured CUDA graph
@@ -68,7 +68,7 @@ TEST_MODULES = ("test_transfer", "test_camclay", "test_camclay_large_strain", "t
                 "test_bonded_camclay_driver", "test_cracking", "test_elasticity", "test_walls",
                 "test_stability_time_step", "test_stability_contrast", "test_stability_impact",
                 "test_stability_singular_F", "test_validation_api", "test_validation_elastic", "test_weak_layer")
-BITWISE_TEST_MODULES = ("test_graph_batching", "test_resume")
+BITWISE_TEST_MODULES = ("test_graph_batching", "test_resume", "test_cuda_paths")
 QUICK_TEST_MODULES = ("test_elasticity", "test_graph_batching")
 
 #: Throughput sizes (approximate particle counts) and steps per repeat.
