@@ -1,11 +1,13 @@
 """CUDA readiness without a GPU: the kernel modules of every ready scene, compiled ahead of time to PTX.
 
-:data:`CASES` are the ready scenes (``scenarios/*.toml``) shrunk to a few thousand particles and a few
-steps, in float32 and float64 and in every geometry the scene has (PST: true 2D, the quasi-2D slab
-``plane_strain = "slab"`` and a 3D column ``width > 0``; shear test: 2D and 3D; the elastic block: its 3D
-box and a 2D one), the P2G variants a scene's materials and output select (the block of Cam-Clay snow,
-yield flags in the output), and the material-point driver (``mpm_warp.material_point``) for each
-material model in 2D and 3D. :func:`run_cases` runs each on the CPU, so that every kernel it needs is built, and
+:data:`CASES` are the ready scenes (``scenarios/*.toml``) shrunk to a few thousand particles (the
+profile's PST, whose 5 mm grid resolves its thin weak layer, to 27k-108k) and a few steps, in float32
+and float64 and in every geometry the scene has (PST: true 2D, the quasi-2D slab
+``plane_strain = "slab"`` and a 3D column ``width > 0``, also for the profile's PST with its cracking
+slab; shear test: 2D and 3D; the elastic block: its 3D box and a 2D one), the P2G variants a scene's
+materials and output select (the block of Cam-Clay snow, yield flags in the output), and the
+material-point driver (``mpm_warp.material_point``) for each material model in 2D and 3D.
+:func:`run_cases` runs each on the CPU, so that every kernel it needs is built, and
 records the Warp modules of the kernels it launched (every kernel is its own module,
 ``module="unique"``). :func:`compile_ptx` compiles each module once per architecture with
 ``wp.compile_aot_module(..., use_ptx=True)``, which needs NVRTC (in the warp-lang wheel) but no GPU
@@ -65,13 +67,17 @@ _GEOMETRIES = {
     "pst": {"2d": _PST, "slab": _PST + ["scene.plane_strain='slab'"], "3d": _PST + ["scene.width=0.02"]},
     "shear_test": {"2d": _SHEAR, "3d": _SHEAR + ["scene.width=0.015"]},
 }
+#: the profile's PST (a layered slab that cracks, on the profile's weak layer): a 30 cm column, a few steps
+_PROFILE = ["scene.length=0.3", "scene.saw.cut_length=0.1", "time.end=0.0002", "time.frame_interval=0.0001"]
+_GEOMETRIES["pst_profile"] = {"2d": _PROFILE, "slab": _PROFILE + ["scene.plane_strain='slab'"],
+                              "3d": _PROFILE + ["scene.width=0.01"]}
 #: the bonded weak layer's P2G with the yield flags (one PST scene: the three share their kernels)
 _PST_YIELDED = {"2d-yielded": _PST + ["output.fields=['x', 'log_jp', 'yielded']"],
                 "3d-yielded": _PST + ["scene.width=0.02", "output.fields=['x', 'log_jp', 'yielded']"]}
 _SCENES = {"elastic_block": "elastic_block", "pst_demo": "pst", "pst_flat": "pst", "pst_slope": "pst",
-           "shear_test": "shear_test"}
+           "pst_profile": "pst_profile", "shear_test": "shear_test"}
 PRECISIONS = ("float32", "float64")
-DRIVER_MODELS = ("elastic", "camclay", "bonded_camclay")
+DRIVER_MODELS = ("elastic", "camclay", "bonded_camclay", "tensile_cracking")
 
 
 @dataclass(frozen=True)
@@ -143,11 +149,13 @@ def launched_modules(into: dict):
 
 def _drive(case: Case) -> None:
     from mpm_warp.material_point import drive_material_points
-    from mpm_warp.materials import BondedCamClay, CamClaySnow, Elastic
+    from mpm_warp.materials import BondedCamClay, CamClaySnow, CrackingSnow, Elastic
 
     mat = {"elastic": Elastic(1e6, 0.3, 250.0),
            "camclay": CamClaySnow(1e6, 0.3, 250.0, M=1.2, beta=0.3, xi=10.0, p0_ini=1e3),
-           "bonded_camclay": BondedCamClay(1e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.05, p_bond=2e3, kappa_s=20.0)}
+           "bonded_camclay": BondedCamClay(1e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.05, p_bond=2e3, kappa_s=20.0),
+           "tensile_cracking": CrackingSnow(1e6, 0.3, 250.0, tensile_strength=5e3, fracture_energy=0.1,
+                                            band_width=0.005)}
     L = np.zeros((3, case.dim, case.dim))
     L[:, 0, 0] = -1e-3                       # three small compressive increments
     r = drive_material_points(L_path=L, material=mat[case.model], dtype=case.precision, device="cpu")
@@ -324,7 +332,8 @@ def summary(runs: dict, compiled: Compiled, seconds: dict) -> dict:
                             "family": next(iter(m.kernels.values())).func.__qualname__.split(".")[0],
                             "entries": sorted(k.get_mangled_name() for k in m.kernels.values()),
                             "ptx": {str(a): p for a, p in compiled.ptx_paths[n].items()},
-                            "ptx_bytes": {str(a): b for a, b in compiled.ptx_bytes[n].items()}}
+                            "ptx_bytes": {str(a): b for a, b in compiled.ptx_bytes[n].items()},
+                            "compile_s": round(compiled.seconds[n], 3)}
                         for r in runs.values() for n, m in r["modules"].items()},
             "failures": [{"module": n, "arch": a, "kernel": compiled.labels[n], "error": e}
                          for (n, a), e in sorted(compiled.failures.items())],
@@ -340,6 +349,7 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=2, help="modules compiled at a time")
     a = ap.parse_args(argv)
     wp.config.quiet = True
+    os.makedirs(a.work, exist_ok=True)
     t0 = time.perf_counter()
     runs = run_cases(a.work)
     t1 = time.perf_counter()

@@ -1,8 +1,8 @@
 """Every kernel the ready scenes and the material-point driver load compiles for CUDA (PTX), without a GPU.
 
-The cases (``tests/helpers_cuda_compile.py``: the five ready scenes in every geometry they have, the P2G
+The cases (``tests/helpers_cuda_compile.py``: the six ready scenes in every geometry they have, the P2G
 variants that a scene's materials and output select, and the material-point driver for each material
-model, float32 and float64, 50 in all) run a few steps on the CPU in a fresh interpreter; the Warp modules
+model, float32 and float64, 60 in all) run a few steps on the CPU in a fresh interpreter; the Warp modules
 of the kernels they launched, each compiled once however many cases share it, are compiled to PTX for
 sm_75 (standing in for sm_70, which the CUDA 13 NVRTC of warp-lang 1.19 no longer targets), sm_80 and
 sm_90 in this test's temporary folder. Any compile error fails the test with the kernel's file, line and
@@ -77,7 +77,7 @@ def compiled(tmp_path_factory):
 
 def test_every_case_ran_and_launched_its_kernels(compiled):
     runs, modules = compiled["cases"], compiled["modules"]
-    assert list(runs) == [c.name for c in CASES] and len(CASES) == 2 * (6 + 3 * 3 + 2 + 2 + 2 * len(DRIVER_MODELS))
+    assert list(runs) == [c.name for c in CASES] and len(CASES) == 2 * (6 + 4 * 3 + 2 + 2 + 2 * len(DRIVER_MODELS))
     for case, r in runs.items():
         families = {modules[n]["family"] for n in r["modules"]}
         if not case.startswith("material_point"):
@@ -95,8 +95,8 @@ def test_every_case_ran_and_launched_its_kernels(compiled):
     for m in modules.values():
         by_family[m["family"]] = by_family.get(m["family"], 0) + 1
     assert by_family["drive_kernel"] == 2 * 2 * len(DRIVER_MODELS)
-    # P2G: elastic, Cam-Clay and the bonded layer, the two plastic ones with and without yield flags
-    assert by_family["p2g_kernel"] == 2 * 2 * 5
+    # P2G: elastic, cracking, Cam-Clay and the bonded layer, the two plastic ones with and without yield flags
+    assert by_family["p2g_kernel"] == 2 * 2 * 6
 
 
 def test_every_module_compiles_to_ptx_for_every_arch(compiled):
