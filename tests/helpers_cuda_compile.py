@@ -42,9 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import warp as wp
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from helpers_scenes import TINY_PST  # noqa: E402
+from helpers_scenes import TINY_PST  # tests/ is on the path: pytest's rootdir, or this script's folder
 
 #: architectures asked for (sm_70, sm_80, sm_90)
 REQUESTED_ARCHS = (70, 80, 90)

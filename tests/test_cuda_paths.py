@@ -185,7 +185,10 @@ def test_device_resolution_with_and_without_cuda(monkeypatch):
     with pytest.raises(InvalidArgument, match="no CUDA device"):
         resolve_device("cuda")
     monkeypatch.setattr(wp, "is_cuda_available", lambda: True)
+    monkeypatch.setattr(wp, "get_cuda_device_count", lambda: 2)
     assert [resolve_device(d) for d in (None, "cuda", "cuda:1", "cpu")] == ["cuda:0", "cuda:0", "cuda:1", "cpu"]
+    with pytest.raises(InvalidArgument, match=r"N in \[0, 1\] \(this machine has 2 CUDA devices\)"):
+        resolve_device("cuda:2")
     monkeypatch.setenv("MPM_WARP_DEVICE", "cpu")
     assert resolve_device(None) == "cpu"
 
