@@ -30,7 +30,7 @@ import argparse
 import os
 import sys
 
-from . import convergence, perf, robustness, snow_runs, snow_studies  # noqa: F401  (registration)
+from . import convergence, main_job, perf, robustness, snow_runs, snow_studies  # noqa: F401  (registration)
 from .core import DOC, SECTIONS, Context, document, pending, section
 from .readme import block, headlines, with_block
 
@@ -49,13 +49,18 @@ def results_markdown(root: str | None = None) -> str:
 
 
 def readme_text(root: str | None = None) -> str | None:
-    """``README.md`` with its headline block regenerated; None when it has no markers (or no README)."""
+    """``README.md`` with its headline block and main-job time regenerated; None without the results markers."""
     root = root or default_root()
     path = os.path.join(root, "README.md")
     if not os.path.isfile(path):
         return None
+    ctx = Context(root)
     with open(path) as fh:
-        return with_block(fh.read(), block(Context(root)))
+        text = with_block(fh.read(), block(ctx))
+    lines = main_job.main_job_block(ctx)
+    if text is not None and lines is not None:     # the main job's time, once its fresh-clone timing is committed
+        text = with_block(text, lines, main_job.BEGIN, main_job.END) or text
+    return text
 
 
 def _write(path: str, text: str) -> None:

@@ -251,6 +251,20 @@ def render_eig3(data: dict, ctx) -> list[str]:
 
 pending("perf", "CUDA: the device suite", "perf/results/device_suite_cuda.json", "bash benchmarks/device_suite.sh",
         question="Does everything hold on a GPU: device tests, graph against eager, throughput, memory, a PST?")
-pending("perf", "CUDA: every kernel compiled to PTX", "perf/results/cuda_ptx.json",
-        "python tests/helpers_cuda_compile.py --work /tmp/ptx --record benchmarks/perf/results/cuda_ptx.json",
-        question="Do the kernels of the ready scenes compile for CUDA without a GPU?")
+@section("perf", "CUDA: every kernel compiled to PTX", "perf/results/cuda_ptx.json",
+         "python tests/helpers_cuda_compile.py --work /tmp/ptx --record benchmarks/perf/results/cuda_ptx.json",
+         question="Do the kernels of the ready scenes compile for CUDA without a GPU?")
+def render_cuda_ptx(data: dict, ctx) -> list[str]:
+    archs = data["archs"]
+    out = [f"{count(data['n_cases'])} cases (every ready scene and the material-point driver, float32 and float64, 2D "
+           f"and 3D where the scene allows, each run a few steps on the CPU) load {count(data['n_modules'])} kernel "
+           f"modules; each compiles to PTX for {', '.join(archs)} (NVRTC -O{data['nvrtc_optimization_level']}), "
+           f"with no GPU and no driver: `tests/test_cuda_compile.py` does it in CI and fails naming the kernel. "
+           f"{data.get('arch_note', '')[:1].upper()}{data.get('arch_note', '')[1:]}.", ""]
+    rows = [["all modules", *(fx(data["total_ptx_bytes"][a], 2, 1e-6) for a in archs)]]
+    fam = data.get("largest_per_kernel_family") or {}
+    for name in sorted(fam, key=lambda k: -fam[k][archs[-1]])[:8]:
+        rows.append([f"largest `{name}`", *(fx(fam[name][a], 3, 1e-6) for a in archs)])
+    out += table(["PTX (MB)", *archs], rows)
+    return out + ["", env_note(data), "", "A record to watch: a kernel whose PTX grows by much has gained code on "
+                  "every GPU."]

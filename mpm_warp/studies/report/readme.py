@@ -120,9 +120,9 @@ def block(ctx: Context) -> list[str]:
     return bullets + ([""] if bullets else []) + [WHERE]
 
 
-def with_block(readme: str, bullets: list[str]) -> str | None:
-    """``readme`` with the text between :data:`BEGIN` and :data:`END` replaced by ``bullets``; None without markers."""
-    i, j = readme.find(BEGIN), readme.find(END)
+def with_block(readme: str, bullets: list[str], begin: str = BEGIN, end: str = END) -> str | None:
+    """``readme`` with the text between ``begin`` and ``end`` replaced by ``bullets``; None without the markers."""
+    i, j = readme.find(begin), readme.find(end)
     if i < 0 or j < i:
         return None
-    return readme[:i + len(BEGIN)] + "\n" + "\n".join(bullets) + "\n" + readme[j:]
+    return readme[:i + len(begin)] + "\n" + "\n".join(bullets) + "\n" + readme[j:]
