@@ -47,7 +47,7 @@ def _standin_plan(monkeypatch, scenario, **kw) -> mw.Simulation:
 
 
 def _cuda_plan(monkeypatch, scenario, **kw) -> mw.Simulation:
-    """The CUDA plan on ``MPM_WARP_TEST_DEVICE`` when it is a GPU (benchmarks/device_suite.py), else the stand-in's."""
+    """The CUDA plan on ``MPM_WARP_TEST_DEVICE`` if a GPU (benchmarks/perf/device_suite.py), else the stand-in."""
     if DEVICE != "cpu":
         return mw.Simulation(scenario, device=DEVICE, **kw)
     return _standin_plan(monkeypatch, scenario, **kw)

@@ -9,7 +9,7 @@ Two stand-ins for a full disk, neither needing a mount:
   and left ``*.ckpt.h5.tmp`` and a stale lock;
 - ``ENOSPC`` raised in-process at the n-th frame, checkpoint or record (the free-space check and plain writes).
 
-A real small tmpfs is exercised by ``benchmarks/disk_full.py`` (needs root and mount).
+A real small tmpfs is exercised by ``benchmarks/robustness/disk_full.py`` (needs root and mount).
 """
 
 from __future__ import annotations

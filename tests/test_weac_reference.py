@@ -23,7 +23,7 @@ W_F = 0.79                                     # J/m^2: the ladder PST's fractur
 
 
 def column(theta=0.0, cut_from="upslope", ends="slope_normal", h=0.3, L=2.2, slab=None):
-    """The error ladder's PST (benchmarks/error_vs_runtime_snow.py PST_SCENE over pst_flat.toml's snow)."""
+    """The error ladder's PST (mpm_warp.studies.snow.ladder_pst over pst_flat.toml's snow)."""
     return wr.StaticColumn(slab=slab or [(h, 250.0, 5.0e6, 0.3)], weak_layer_thickness=0.06, weak_layer_E=1.0e6,
                            weak_layer_nu=0.3, length=L, slope_angle=theta, cut_from=cut_from, column_ends=ends)
 
