@@ -78,3 +78,21 @@ def test_not_a_pst_is_refused_by_name(tmp_path):
     mw.run("elastic_block", out, "cpu", ["time.end=0.01", "time.frame_interval=0.01"])
     with pytest.raises(InvalidArgument, match=r"^path = .*block\.h5' is invalid: expected a PST run file"):
         pst_picture(out, str(tmp_path / "p.png"))
+
+
+def test_plotting_a_run_file_starts_no_simulation(running_pst, tmp_path, monkeypatch):
+    """Post only reads run files: the stored calibration, never a material-point drive or a Simulation."""
+    import mpm_warp.material_point as material_point
+    import mpm_warp.scenes.weak_layer.paths as paths
+    from mpm_warp.scenes.weak_layer import params as wl_params
+
+    def forbidden(*a, **k):
+        raise AssertionError("plotting started a simulation")
+    monkeypatch.setattr(material_point, "drive_material_points", forbidden)
+    monkeypatch.setattr(paths, "drive_material_points", forbidden)
+    monkeypatch.setattr(mw.Simulation, "__init__", forbidden)
+    wl_params._calibrate.cache_clear()                      # a cached calibration would hide a call
+    _not_blank(_rgb(pst_picture(running_pst, str(tmp_path / "pst.png"))))
+    assert main(["plot", running_pst, "--out", str(tmp_path / "cli")]) == 0
+    with pytest.raises(AssertionError, match="started a simulation"):   # the guard does catch a drive
+        paths.drive_material_points()
