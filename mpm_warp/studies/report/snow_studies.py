@@ -126,14 +126,6 @@ def render_weac(data: dict, ctx) -> list[str]:
 
 
 # ----------------------------------------------------------------------------- still to come
-pending("snow", "The three field outcomes: END, SF, ARR", "snow/results/pst_outcomes.json",
-        "python benchmarks/snow/pst_outcomes.py",
-        question="Does a PST end as the field writes it (the crack reaches the end, the slab breaks, the crack "
-                 "arrests), with the slab's break beside weac's peak tensile stress?")
-pending("snow", "The snowpack's critical cut: layering and column ends", "snow/results/snowpack_critical_cut.json",
-        "python benchmarks/snow/snowpack_critical_cut.py",
-        question="Does the snowpack change the critical cut as weac says (layered slabs, slope-normal against "
-                 "vertical ends)?")
 pending("snow", "Stress at the weak layer's interfaces", "snow/results/interface_stress_cpu.json",
         "python benchmarks/snow/interface_stress.py --parts column model1d shear pst",
         question="How much load do the rows next to a stiffness jump carry, with and without the laminate closure?")
