@@ -12,12 +12,12 @@ def _modulus(ly: dict) -> str:
 
 
 def _slab(layers: list) -> str:
-    """``'3 x 10 cm (1/5/20 MPa)'`` or ``'30 cm, 250 kg/m^3, 5.0 MPa'`` from a case's slab layers, top first."""
+    """``'10 + 10 + 10 cm (1.0 MPa / 5.0 MPa / 20.0 MPa, top first)'`` or ``'30 cm, 250 kg/m^3, 5.0 MPa'``."""
     if not layers:
         return DASH
     if len(layers) == 1:
         ly = layers[0]
-        return f"{fx(ly['thickness'], 0, 100)} cm, {fx(ly['density'], 0)} kg/m^3, {fx(ly.get('E'), 2, 1e-6)} MPa"
+        return f"{fx(ly['thickness'], 0, 100)} cm, {fx(ly['density'], 0)} kg/m^3, {_modulus(ly)}"
     return (" + ".join(f"{fx(ly['thickness'], 0, 100)}" for ly in layers) + " cm ("
             + " / ".join(_modulus(ly) for ly in layers) + ", top first)")
 
