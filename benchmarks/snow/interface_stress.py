@@ -1,0 +1,137 @@
+"""How much load do the rows next to a stiffness jump carry, with and without the laminate closure?
+
+The settled column (:mod:`mpm_warp.studies.interface_column`: ``pst_demo``'s substratum, 3 cm weak layer and
+slab between slip walls, settled as the PST settles) at 3, 4, 6, 12 and 24 cells across the layer: each
+particle row's ``sigma_yy`` beside the overburden at its height, without and with ``scene.interface_closure``
+(docs/model.md §5b). Part ``free``: ``pst_demo`` itself settled (free ends), the particle column at
+x = 2.1 m. Part ``shear``: the shear test's peak against the given tau_p at 4 and 8 cells, without and with.
+Writes ``benchmarks/snow/results/interface_stress_<dev>.json`` and ``.png`` (sigma_yy / overburden per row
+against the height above the layer's base).
+
+Usage::
+
+    .venv/bin/python benchmarks/snow/interface_stress.py [--parts column free shear] [--quick]
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+import numpy as np
+
+import mpm_warp as mw
+from mpm_warp.scenes.shear_test import shear_curves
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.interface_column import column_rows, free_column_rows
+from mpm_warp.studies.protocol import out_dir, parser, result_name
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+CELLS = (3, 4, 6, 12, 24)
+SHEAR_CELLS = (4, 8)
+ON = "scene.interface_closure=true"
+
+
+def _slim(r: dict) -> dict:
+    return {k: v for k, v in r.items() if k != "rows"}
+
+
+def column_part(cells, device: str) -> dict:
+    out = {}
+    for label, over in (("off", ()), ("on", (ON,))):
+        out[label] = [_slim(column_rows(c, overrides=over, device=device)) for c in cells]
+    out["cost_ratio_on_over_off"] = [b["s_per_particle_step"] / a["s_per_particle_step"]
+                                     for a, b in zip(out["off"], out["on"], strict=True)]
+    return out
+
+
+def free_part(device: str) -> dict:
+    return {label: _slim(free_column_rows(overrides=over, device=device))
+            for label, over in (("off", ()), ("on", (ON,)))}
+
+
+def shear_part(cells, device: str) -> dict:
+    out = {}
+    for label, over in (("off", []), ("on", [ON])):
+        runs = []
+        for n in cells:
+            sc = mw.load_scenario("shear_test")
+            dx = sc.scene.weak_layer_thickness / n
+            t0 = time.perf_counter()
+            rr = mw.run("shear_test", device=device, overrides=[f"scene.dx={dx!r}", *over])
+            mon = rr.monitor
+            c = shear_curves(mon.params, mon.times, {k: np.asarray(v) for k, v in mon.series.items()})
+            res = rr.scene_result
+            runs.append({"cells": n, "dx": dx, "wall_s": time.perf_counter() - t0, "steps": rr.steps,
+                         "peak_shear_stress": res["peak_shear_stress"], "tau_p": res["tau_p_calibrated"],
+                         "peak_over_tau_p": res["peak_shear_stress"] / res["tau_p_calibrated"],
+                         "residual_shear_stress": res["residual_shear_stress"],
+                         "softening_displacement": res["softening_displacement"],
+                         "tau_curve": {k: np.asarray(c[k])[::10].tolist() for k in ("slip", "tau")}})
+        out[label] = runs
+    return out
+
+
+def figure(data: dict, path: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    col = data["column"]
+    fig, ax = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
+    for a, label in zip(ax, ("off", "on"), strict=True):
+        for k, r in enumerate(col[label]):
+            base = data["substratum_depth"]
+            h = [(x["y0"] - base) / data["weak_layer_thickness"] for x in r["near"]]
+            a.plot([x["ratio"] for x in r["near"]], h, "o-", ms=3, color=f"C{k}",
+                   label=f"{r['cells']:g} cells (dx {1e3 * r['dx']:.3g} mm): worst {100 * r['worst']:.1f} %")
+        a.axvline(1.0, color="k", lw=0.8)
+        a.axvspan(0.95, 1.05, color="0.9", zorder=0)
+        for y in (0.0, 1.0):
+            a.axhline(y, color="0.5", ls=":", lw=0.8)
+        a.set(xlabel="sigma_yy / overburden per particle row [-]",
+              title=f"interface closure {label}" + (" (plain MLS-MPM)" if label == "off" else " (laminate)"))
+        a.legend(fontsize=7)
+    ax[0].set_ylabel("height above the weak layer's base / its thickness [-]")
+    fig.suptitle("settled column (pst_demo's stack between slip walls): rows within 3 cells of the weak layer; "
+                 "grey band: 5 %", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = parser(__doc__, "the column at 3 and 4 cells only")
+    ap.add_argument("--parts", nargs="+", default=["column", "free", "shear"], choices=["column", "free", "shear"])
+    a = ap.parse_args(argv)
+    cells = (3, 4) if a.quick else CELLS
+    parts = ["column"] if a.quick else a.parts
+    sc = mw.load_scenario("pst_demo")
+    data = {"scenario": "pst_demo", "weak_layer_thickness": sc.scene.weak_layer_thickness,
+            "substratum_depth": sc.scene.substratum_depth, "tolerance": 0.05}
+    if "column" in parts:
+        data["column"] = column_part(cells, a.device)
+    if "free" in parts:
+        data["free"] = free_part(a.device)
+    if "shear" in parts:
+        data["shear"] = shear_part(SHEAR_CELLS, a.device)
+    data["environment"] = environment(a.device)
+    folder = out_dir(a, RESULTS, "interface_stress")
+    name = result_name("interface_stress", a)
+    print("wrote", write_json(name, data, folder))
+    if "column" in data:
+        figure(data, os.path.join(folder, name + ".png"))
+        for label in ("off", "on"):
+            for r in data["column"][label]:
+                print(f"closure {label}, {r['cells']:g} cells: worst row {100 * r['worst']:.2f} % off the overburden, "
+                      f"{r['wall_s']:.1f} s")
+    for label, runs in (data.get("shear") or {}).items():
+        for r in runs:
+            print(f"shear test, closure {label}, {r['cells']} cells: peak / tau_p = {r['peak_over_tau_p']:.4f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
