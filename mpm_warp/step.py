@@ -216,7 +216,7 @@ class Stepper:
         """Every recorded launch of the plan (for compiling ahead of timing)."""
         walls = [self._wall_state] if self._wall_state is not None else []
         return [self._begin, *walls, *[k for ks in self._p2g for k in ks], *self._grid, *self._g2p,
-                *self._columns, self._end, *self.actions]
+                *self._columns, self._end, *self.actions, *self._closure]
 
     # ------------------------------------------------------------------ steps
     def _scatter(self, k: int) -> None:
