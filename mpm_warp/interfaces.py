@@ -15,7 +15,7 @@ import numpy as np
 
 from .errors import InvalidArgument
 
-__all__ = ["closure_factors"]
+__all__ = ["closure_factors", "stack_factors"]
 
 
 def closure_factors(model) -> list[tuple[int, np.ndarray, np.ndarray]]:
@@ -44,38 +44,69 @@ def closure_factors(model) -> list[tuple[int, np.ndarray, np.ndarray]]:
             lam.append(np.full(n, m.lam))
             mid.append(np.full(n, k))
         idx, y, vol, M, G, lam, mid = map(np.concatenate, (idx, y, vol, M, G, lam, mid))
-        o, dx = float(model.origin[axis]), float(model.dx)
-        cell = np.floor((y - o) / dx).astype(np.int64)
-        cells, inv = np.unique(cell, return_inverse=True)
-        v = np.bincount(inv, vol)
-        cn = np.bincount(inv, vol / M) / v
-        cs = np.bincount(inv, vol / G) / v
-        # a cell of one block's particles only: its block, else -1
-        lo_id = np.full(len(cells), np.iinfo(np.int64).max)
-        hi_id = np.full(len(cells), -1)
-        np.minimum.at(lo_id, inv, mid)
-        np.maximum.at(hi_id, inv, mid)
-        pure = np.where(lo_id == hi_id, lo_id, -1)
-        if np.any(np.diff(cells) != 1):
-            raise InvalidArgument(f"blocks with interface_normal = {axis}", "a stack with a gap",
-                                  "blocks that fill the stack's cells without an empty cell between them")
-        # the MLS strain the stencil gives the cumulative compliance (the displacement of a unit stress)
-        b = np.floor((y - o) / dx - 0.5).astype(np.int64)
-        f = (y - o) / dx - b
-        w = (0.5 * (1.5 - f) ** 2, 0.75 - (f - 1.0) ** 2, 0.5 * (f - 0.5) ** 2)
-        c_n = sum(4.0 * w[a] * (a - f) * _cumulative(cn, b + a - cells[0]) for a in range(3))
-        c_s = sum(4.0 * w[a] * (a - f) * _cumulative(cs, b + a - cells[0]) for a in range(3))
-        # the particle's stencil spans the cells b and b + 1: changed unless both hold its own block only
-        k0, k1 = np.clip(b - cells[0], 0, len(cells) - 1), np.clip(b + 1 - cells[0], 0, len(cells) - 1)
-        band = ~((pure[k0] == mid) & (pure[k1] == mid))
-        r_n = 1.0 / (c_n[band] * M[band])
-        r_s = 1.0 / (c_s[band] * G[band])
-        if not (np.all(r_n > 0.0) and np.all(r_s > 0.0)):
-            raise InvalidArgument(f"blocks with interface_normal = {axis}", "a non-positive smeared compliance",
-                                  "a stack of layers each at least a cell thick")
-        fac = np.stack([r_n, r_s, (r_n - 1.0) * lam[band] / M[band]], axis=1)
+        band, fac = stack_factors(y, vol, M, G, lam, mid, float(model.origin[axis]), float(model.dx),
+                                  f"blocks with interface_normal = {axis}")
         out.append((int(axis), idx[band].astype(np.int32), fac))
     return out
+
+
+def stack_factors(y, vol, M, G, lam, block, origin: float, dx: float, where: str = "stack"):
+    """The closure of one stack's particles: which it changes and their factors.
+
+    Parameters
+    ----------
+    y : (n,) float
+        Positions along the stack's axis (m).
+    vol : (n,) float
+        Volumes (m^3; any common unit).
+    M, G, lam : (n,) float
+        Constrained modulus ``lambda + 2 mu``, shear modulus ``mu`` and ``lambda`` (Pa).
+    block : (n,) int
+        The block (layer) of each particle.
+    origin, dx : float
+        The grid's origin along the axis and its spacing (m).
+    where : str
+        What the errors name.
+
+    Returns
+    -------
+    band : (n,) bool
+        The particles the closure changes.
+    fac : (n_band, 3) float
+        Their ``(r_n, r_s, c_p)``.
+    """
+    o, mid = origin, block
+    y, vol, M, G, lam = (np.asarray(a, dtype=float) for a in (y, vol, M, G, lam))
+    cell = np.floor((y - o) / dx).astype(np.int64)
+    cells, inv = np.unique(cell, return_inverse=True)
+    v = np.bincount(inv, vol)
+    cn = np.bincount(inv, vol / M) / v
+    cs = np.bincount(inv, vol / G) / v
+    # a cell of one block's particles only: its block, else -1
+    lo_id = np.full(len(cells), np.iinfo(np.int64).max)
+    hi_id = np.full(len(cells), -1)
+    np.minimum.at(lo_id, inv, mid)
+    np.maximum.at(hi_id, inv, mid)
+    pure = np.where(lo_id == hi_id, lo_id, -1)
+    if np.any(np.diff(cells) != 1):
+        raise InvalidArgument(where, "a stack with a gap",
+                              "blocks that fill the stack's cells without an empty cell between them")
+    # the MLS strain the stencil gives the cumulative compliance (the displacement of a unit stress)
+    b = np.floor((y - o) / dx - 0.5).astype(np.int64)
+    f = (y - o) / dx - b
+    w = (0.5 * (1.5 - f) ** 2, 0.75 - (f - 1.0) ** 2, 0.5 * (f - 0.5) ** 2)
+    c_n = sum(4.0 * w[a] * (a - f) * _cumulative(cn, b + a - cells[0]) for a in range(3))
+    c_s = sum(4.0 * w[a] * (a - f) * _cumulative(cs, b + a - cells[0]) for a in range(3))
+    # the particle's stencil spans the cells b and b + 1: changed unless both hold its own block only
+    k0, k1 = np.clip(b - cells[0], 0, len(cells) - 1), np.clip(b + 1 - cells[0], 0, len(cells) - 1)
+    band = ~((pure[k0] == mid) & (pure[k1] == mid))
+    r_n = 1.0 / (c_n[band] * M[band])
+    r_s = 1.0 / (c_s[band] * G[band])
+    if not (np.all(r_n > 0.0) and np.all(r_s > 0.0)):
+        raise InvalidArgument(where, "a non-positive smeared compliance",
+                              "a stack of layers each at least a cell thick")
+    fac = np.stack([r_n, r_s, (r_n - 1.0) * lam[band] / M[band]], axis=1)
+    return band, fac
 
 
 def _cumulative(c: np.ndarray, k: np.ndarray) -> np.ndarray:

@@ -4,7 +4,9 @@ The settled column (:mod:`mpm_warp.studies.interface_column`: ``pst_demo``'s sub
 slab between slip walls, settled as the PST settles) at 3, 4, 6, 12 and 24 cells across the layer: each
 particle row's ``sigma_yy`` beside the overburden at its height, without and with ``scene.interface_closure``
 (docs/model.md §5b). Part ``free``: ``pst_demo`` itself settled (free ends), the particle column at
-x = 2.1 m. Part ``shear``: the shear test's peak against the given tau_p at 4 and 8 cells, without and with.
+x = 2.1 m. Part ``shear``: the shear test's peak against the given tau_p at 4 and 8 cells, without and with. Part
+``model1d``: the same column as a 1D static problem (:mod:`mpm_warp.studies.interface_model1d`), plain, with
+B-bar-like averaging per cell and layer, and with the closure. Parts run apart are merged into the file.
 Writes ``benchmarks/snow/results/interface_stress_<dev>.json`` and ``.png`` (sigma_yy / overburden per row
 against the height above the layer's base).
 
@@ -15,6 +17,7 @@ Usage::
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 import time
@@ -23,6 +26,7 @@ import numpy as np
 
 import mpm_warp as mw
 from mpm_warp.scenes.shear_test import shear_curves
+from mpm_warp.studies import interface_model1d
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.interface_column import column_rows, free_column_rows
 from mpm_warp.studies.protocol import out_dir, parser, result_name
@@ -30,6 +34,7 @@ from mpm_warp.studies.protocol import out_dir, parser, result_name
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 CELLS = (3, 4, 6, 12, 24)
 SHEAR_CELLS = (4, 8)
+PARTS = ("column", "model1d", "free", "shear")
 ON = "scene.interface_closure=true"
 
 
@@ -43,6 +48,20 @@ def column_part(cells, device: str) -> dict:
         out[label] = [_slim(column_rows(c, overrides=over, device=device)) for c in cells]
     out["cost_ratio_on_over_off"] = [b["s_per_particle_step"] / a["s_per_particle_step"]
                                      for a, b in zip(out["off"], out["on"], strict=True)]
+    return out
+
+
+def model1d_part(cells) -> dict:
+    out = {}
+    for scheme in interface_model1d.SCHEMES:
+        runs = []
+        for c in cells:
+            r = interface_model1d.static_rows(c, scheme)
+            k = r["near"]
+            runs.append({"cells": float(c), "dx": r["dx"], "worst": r["worst"],
+                         "zero_energy_modes": r["zero_energy_modes"], "y0": r["y"][k].tolist(),
+                         "ratio": r["ratio"][k].tolist()})
+        out[scheme] = runs
     return out
 
 
@@ -104,22 +123,25 @@ def figure(data: dict, path: str) -> None:
 
 def main(argv=None) -> int:
     ap = parser(__doc__, "the column at 3 and 4 cells only")
-    ap.add_argument("--parts", nargs="+", default=["column", "free", "shear"], choices=["column", "free", "shear"])
+    ap.add_argument("--parts", nargs="+", default=list(PARTS), choices=list(PARTS))
     a = ap.parse_args(argv)
     cells = (3, 4) if a.quick else CELLS
-    parts = ["column"] if a.quick else a.parts
+    parts = ["column", "model1d"] if a.quick else a.parts
     sc = mw.load_scenario("pst_demo")
     data = {"scenario": "pst_demo", "weak_layer_thickness": sc.scene.weak_layer_thickness,
             "substratum_depth": sc.scene.substratum_depth, "tolerance": 0.05}
-    if "column" in parts:
-        data["column"] = column_part(cells, a.device)
-    if "free" in parts:
-        data["free"] = free_part(a.device)
-    if "shear" in parts:
-        data["shear"] = shear_part(SHEAR_CELLS, a.device)
-    data["environment"] = environment(a.device)
     folder = out_dir(a, RESULTS, "interface_stress")
     name = result_name("interface_stress", a)
+    old = os.path.join(folder, name + ".json")
+    if os.path.exists(old):  # parts run apart: keep the others
+        with open(old) as f:
+            data = {**json.load(f), **data}
+    run = {"column": lambda: column_part(cells, a.device), "model1d": lambda: model1d_part(cells),
+           "free": lambda: free_part(a.device), "shear": lambda: shear_part(SHEAR_CELLS, a.device)}
+    for part in parts:
+        data[part] = run[part]()
+        data[part]["environment"] = environment(a.device)
+    data["environment"] = environment(a.device)
     print("wrote", write_json(name, data, folder))
     if "column" in data:
         figure(data, os.path.join(folder, name + ".png"))
@@ -127,7 +149,9 @@ def main(argv=None) -> int:
             for r in data["column"][label]:
                 print(f"closure {label}, {r['cells']:g} cells: worst row {100 * r['worst']:.2f} % off the overburden, "
                       f"{r['wall_s']:.1f} s")
-    for label, runs in (data.get("shear") or {}).items():
+    for scheme, runs in ((k, v) for k, v in (data.get("model1d") or {}).items() if k != "environment"):
+        print(f"1D static, {scheme}: worst row " + ", ".join(f"{100 * r['worst']:.2f} %" for r in runs))
+    for label, runs in ((k, v) for k, v in (data.get("shear") or {}).items() if k != "environment"):
         for r in runs:
             print(f"shear test, closure {label}, {r['cells']} cells: peak / tau_p = {r['peak_over_tau_p']:.4f}")
     return 0
