@@ -6,13 +6,14 @@ particle row's ``sigma_yy`` beside the overburden at its height, without and wit
 (docs/model.md §5b). Part ``free``: ``pst_demo`` itself settled (free ends), the particle column at
 x = 2.1 m. Part ``shear``: the shear test's peak against the given tau_p at 4 and 8 cells, without and with. Part
 ``model1d``: the same column as a 1D static problem (:mod:`mpm_warp.studies.interface_model1d`), plain, with
-B-bar-like averaging per cell and layer, and with the closure. Parts run apart are merged into the file.
+B-bar-like averaging per cell and layer, and with the closure. Part ``cost``: CPU time per particle-step of
+``pst_demo`` while settling, without and with the closure. Parts run apart are merged into the file.
 Writes ``benchmarks/snow/results/interface_stress_<dev>.json`` and ``.png`` (sigma_yy / overburden per row
 against the height above the layer's base).
 
 Usage::
 
-    .venv/bin/python benchmarks/snow/interface_stress.py [--parts column free shear] [--quick]
+    .venv/bin/python benchmarks/snow/interface_stress.py [--parts column model1d free shear cost] [--quick]
 """
 
 from __future__ import annotations
@@ -28,13 +29,13 @@ import mpm_warp as mw
 from mpm_warp.scenes.shear_test import shear_curves
 from mpm_warp.studies import interface_model1d
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.interface_column import column_rows, free_column_rows
+from mpm_warp.studies.interface_column import column_rows, free_column_rows, step_cost
 from mpm_warp.studies.protocol import out_dir, parser, result_name
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 CELLS = (3, 4, 6, 12, 24)
 SHEAR_CELLS = (4, 8)
-PARTS = ("column", "model1d", "free", "shear")
+PARTS = ("column", "model1d", "free", "shear", "cost")
 ON = "scene.interface_closure=true"
 
 
@@ -63,6 +64,16 @@ def model1d_part(cells) -> dict:
                          "ratio": r["ratio"][k].tolist()})
         out[scheme] = runs
     return out
+
+
+def cost_part(device: str, rounds: int = 3) -> dict:
+    """pst_demo's step without and with the closure, alternated ``rounds`` times (the best of each)."""
+    runs = {"off": [], "on": []}
+    for _ in range(rounds):
+        for label, over in (("off", ()), ("on", (ON,))):
+            runs[label].append(step_cost("pst_demo", over, device=device))
+    best = {k: min(r["s_per_particle_step"] for r in v) for k, v in runs.items()}
+    return {**runs, "best_s_per_particle_step": best, "ratio_on_over_off": best["on"] / best["off"]}
 
 
 def free_part(device: str) -> dict:
@@ -137,9 +148,12 @@ def main(argv=None) -> int:
         with open(old) as f:
             data = {**json.load(f), **data}
     run = {"column": lambda: column_part(cells, a.device), "model1d": lambda: model1d_part(cells),
-           "free": lambda: free_part(a.device), "shear": lambda: shear_part(SHEAR_CELLS, a.device)}
+           "free": lambda: free_part(a.device), "shear": lambda: shear_part(SHEAR_CELLS, a.device),
+           "cost": lambda: cost_part(a.device)}
     for part in parts:
+        t0 = time.perf_counter()
         data[part] = run[part]()
+        data[part]["part_wall_s"] = time.perf_counter() - t0
         data[part]["environment"] = environment(a.device)
     data["environment"] = environment(a.device)
     print("wrote", write_json(name, data, folder))
@@ -151,6 +165,8 @@ def main(argv=None) -> int:
                       f"{r['wall_s']:.1f} s")
     for scheme, runs in ((k, v) for k, v in (data.get("model1d") or {}).items() if k != "environment"):
         print(f"1D static, {scheme}: worst row " + ", ".join(f"{100 * r['worst']:.2f} %" for r in runs))
+    if "cost" in data:
+        print(f"cost per particle-step, closure on / off: {data['cost']['ratio_on_over_off']:.3f}")
     for label, runs in ((k, v) for k, v in (data.get("shear") or {}).items() if k != "environment"):
         for r in runs:
             print(f"shear test, closure {label}, {r['cells']} cells: peak / tau_p = {r['peak_over_tau_p']:.4f}")

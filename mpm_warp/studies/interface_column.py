@@ -21,7 +21,8 @@ from ..scenes.snow import GRAVITY
 from ..simulation import Simulation
 from ..walls import Wall
 
-__all__ = ["column_scenario", "overburden", "settled_rows", "column_rows", "free_column_rows", "row_ratios"]
+__all__ = ["column_scenario", "overburden", "settled_rows", "column_rows", "free_column_rows", "row_ratios",
+           "step_cost"]
 
 
 def column_scenario(cells: float, scenario: str = "pst_demo", width_cells: int = 4, overrides=()):
@@ -159,3 +160,27 @@ def free_column_rows(scenario: str = "pst_demo", x: float = 2.1, overrides=(), d
     rows = settled_rows(sim, (xc - 0.5 * h, xc + 0.5 * h))
     return {"x": float(xc), "rows": rows, "near": row_ratios(rows, sc.scene), "wall_s": wall, "steps": int(steps),
             "particles": int(sim.model.n_particles)}
+
+
+def step_cost(scenario: str = "pst_demo", overrides=(), steps: int = 200, repeats: int = 3,
+              device: str = "cpu") -> dict:
+    """CPU seconds per particle-step of ``scenario`` while settling, the best of ``repeats`` batches of ``steps``.
+
+    The simulation is built and compiled (one warm-up batch) before timing; the process's CPU time is the
+    clock (the shared machine's other work does not count, as in :mod:`.timing`).
+    """
+    sc = load_scenario(scenario, list(overrides))
+    sim = Simulation(sc, device=device, n_threads=1)
+    sim.stepper.set_frame_end(float(sc.scene.settle.duration))
+    sim.stepper.steps(steps)
+    sim.stepper.clock()
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.process_time()
+        sim.stepper.steps(steps)
+        sim.stepper.clock()
+        best = min(best, time.process_time() - t0)
+    n = sim.model.n_particles
+    return {"scenario": scenario, "overrides": list(overrides), "particles": int(n), "steps": steps,
+            "repeats": repeats, "closure_particles": int(sum(len(a[0]) for a in sim.stepper._closure_arrays)),
+            "s_per_particle_step": best / (steps * n)}
