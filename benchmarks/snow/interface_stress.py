@@ -163,11 +163,11 @@ def main(argv=None) -> int:
             for r in data["column"][label]:
                 print(f"closure {label}, {r['cells']:g} cells: worst row {100 * r['worst']:.2f} % off the overburden, "
                       f"{r['wall_s']:.1f} s")
-    for scheme, runs in ((k, v) for k, v in (data.get("model1d") or {}).items() if k != "environment"):
+    for scheme, runs in ((k, v) for k, v in (data.get("model1d") or {}).items() if k in interface_model1d.SCHEMES):
         print(f"1D static, {scheme}: worst row " + ", ".join(f"{100 * r['worst']:.2f} %" for r in runs))
     if "cost" in data:
         print(f"cost per particle-step, closure on / off: {data['cost']['ratio_on_over_off']:.3f}")
-    for label, runs in ((k, v) for k, v in (data.get("shear") or {}).items() if k != "environment"):
+    for label, runs in ((k, v) for k, v in (data.get("shear") or {}).items() if k in ("off", "on")):
         for r in runs:
             print(f"shear test, closure {label}, {r['cells']} cells: peak / tau_p = {r['peak_over_tau_p']:.4f}")
     return 0
