@@ -7,13 +7,14 @@ particle row's ``sigma_yy`` beside the overburden at its height, without and wit
 x = 2.1 m. Part ``shear``: the shear test's peak against the given tau_p at 4 and 8 cells, without and with. Part
 ``model1d``: the same column as a 1D static problem (:mod:`mpm_warp.studies.interface_model1d`), plain, with
 B-bar-like averaging per cell and layer, and with the closure. Part ``cost``: CPU time per particle-step of
-``pst_demo`` while settling, without and with the closure. Parts run apart are merged into the file.
+``pst_demo`` while settling, without and with the closure. Part ``ladder``: the PST ladder's two coarsest
+levels (``pst_flat`` as the error ladder runs it), without and with. Parts run apart are merged into the file.
 Writes ``benchmarks/snow/results/interface_stress_<dev>.json`` and ``.png`` (sigma_yy / overburden per row
 against the height above the layer's base).
 
 Usage::
 
-    .venv/bin/python benchmarks/snow/interface_stress.py [--parts column model1d free shear cost] [--quick]
+    .venv/bin/python benchmarks/snow/interface_stress.py [--parts column model1d free shear cost ladder] [--quick]
 """
 
 from __future__ import annotations
@@ -26,16 +27,20 @@ import time
 import numpy as np
 
 import mpm_warp as mw
+from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.shear_test import shear_curves
 from mpm_warp.studies import interface_model1d
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.interface_column import column_rows, free_column_rows, step_cost
 from mpm_warp.studies.protocol import out_dir, parser, result_name
+from mpm_warp.studies.snow import PST_BRACKET, PST_DX, ladder_pst
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 CELLS = (3, 4, 6, 12, 24)
 SHEAR_CELLS = (4, 8)
-PARTS = ("column", "model1d", "free", "shear", "cost")
+PARTS = ("column", "model1d", "free", "shear", "cost", "ladder")
+#: the PST ladder's two coarsest levels (3 and 6 cells across its 6 cm layer)
+LADDER_DX = PST_DX[:2]
 ON = "scene.interface_closure=true"
 
 
@@ -74,6 +79,28 @@ def cost_part(device: str, rounds: int = 3) -> dict:
             runs[label].append(step_cost("pst_demo", over, device=device))
     best = {k: min(r["s_per_particle_step"] for r in v) for k, v in runs.items()}
     return {**runs, "best_s_per_particle_step": best, "ratio_on_over_off": best["on"] / best["off"]}
+
+
+def ladder_part(device: str) -> dict:
+    """The PST ladder's two coarsest levels without and with the closure: critical cut, speed, touchdown, collapse
+    height (as ``benchmarks/convergence/error_vs_runtime_snow.py`` runs a level)."""
+    out = {}
+    for label, over in (("off", []), ("on", [ON])):
+        levels = []
+        for dx in LADDER_DX:
+            sc = mw.load_scenario("pst_flat", ladder_pst(dx) + over)
+            t0 = time.perf_counter()
+            res = critical_cut(sc, device=device, base_run_distance=sc.scene.length, base_free_run=0.5,
+                               **PST_BRACKET, workers=1, n_threads=1)
+            b = res.base
+            levels.append({"dx": dx, "cells_across_layer": sc.scene.weak_layer_thickness / dx,
+                           "critical_cut": res.value if res.bracketed else float("nan"),
+                           "critical_cut_bracket": [res.lo, res.hi], "bracketed": res.bracketed,
+                           "speed": b.get("damage_speed_mean"), "touchdown": b.get("touchdown"),
+                           "collapse_height": b.get("collapse_height"), "wall_s": time.perf_counter() - t0,
+                           "steps": int(sum(t["steps"] for t in res.trials))})
+        out[label] = levels
+    return out
 
 
 def free_part(device: str) -> dict:
@@ -134,7 +161,8 @@ def figure(data: dict, path: str) -> None:
 
 def main(argv=None) -> int:
     ap = parser(__doc__, "the column at 3 and 4 cells only")
-    ap.add_argument("--parts", nargs="+", default=list(PARTS), choices=list(PARTS))
+    ap.add_argument("--parts", nargs="+", default=[p for p in PARTS if p != "ladder"], choices=list(PARTS),
+                    help="parts to run (default all but ladder, about 12 min of CPU more)")
     a = ap.parse_args(argv)
     cells = (3, 4) if a.quick else CELLS
     parts = ["column", "model1d"] if a.quick else a.parts
@@ -149,7 +177,7 @@ def main(argv=None) -> int:
             data = {**json.load(f), **data}
     run = {"column": lambda: column_part(cells, a.device), "model1d": lambda: model1d_part(cells),
            "free": lambda: free_part(a.device), "shear": lambda: shear_part(SHEAR_CELLS, a.device),
-           "cost": lambda: cost_part(a.device)}
+           "cost": lambda: cost_part(a.device), "ladder": lambda: ladder_part(a.device)}
     for part in parts:
         t0 = time.perf_counter()
         data[part] = run[part]()
@@ -165,6 +193,10 @@ def main(argv=None) -> int:
                       f"{r['wall_s']:.1f} s")
     for scheme, runs in ((k, v) for k, v in (data.get("model1d") or {}).items() if k in interface_model1d.SCHEMES):
         print(f"1D static, {scheme}: worst row " + ", ".join(f"{100 * r['worst']:.2f} %" for r in runs))
+    for label, levels in ((k, v) for k, v in (data.get("ladder") or {}).items() if k in ("off", "on")):
+        for r in levels:
+            print(f"PST ladder, closure {label}, dx {r['dx']}: critical cut {r['critical_cut']}, speed {r['speed']}, "
+                  f"touchdown {r['touchdown']}, collapse height {r['collapse_height']}, {r['wall_s']:.0f} s")
     if "cost" in data:
         print(f"cost per particle-step, closure on / off: {data['cost']['ratio_on_over_off']:.3f}")
     for label, runs in ((k, v) for k, v in (data.get("shear") or {}).items() if k in ("off", "on")):
