@@ -4,7 +4,8 @@ The settled column (:mod:`mpm_warp.studies.interface_column`: ``pst_demo``'s sub
 slab between slip walls, settled as the PST settles) at 3, 4, 6, 12 and 24 cells across the layer: each
 particle row's ``sigma_yy`` beside the overburden at its height, without and with ``scene.interface_closure``
 (docs/model.md §5b). Part ``free``: ``pst_demo`` itself settled (free ends), the particle column at
-x = 2.1 m. Part ``shear``: the shear test's peak against the given tau_p at 4 and 8 cells, without and with. Part
+x = 2.1 m. Part ``shear``: the shear test's peak against the given tau_p at 4 and 8 cells (and at 4 on a sample twice as
+long), without and with. Part
 ``model1d``: the same column as a 1D static problem (:mod:`mpm_warp.studies.interface_model1d`), plain, with
 B-bar-like averaging per cell and layer, and with the closure. Part ``cost``: CPU time per particle-step of
 ``pst_demo`` while settling, without and with the closure. Part ``ladder``: the PST ladder's two coarsest
@@ -109,18 +110,22 @@ def free_part(device: str) -> dict:
 
 
 def shear_part(cells, device: str) -> dict:
+    """The shear test at ``cells`` and, at the first, on a sample of twice the length (its free ends' share)."""
     out = {}
+    base = mw.load_scenario("shear_test").scene
+    cases = [(n, base.sample_length) for n in cells] + [(cells[0], 2.0 * base.sample_length)]
     for label, over in (("off", []), ("on", [ON])):
         runs = []
-        for n in cells:
-            sc = mw.load_scenario("shear_test")
-            dx = sc.scene.weak_layer_thickness / n
+        for n, Ls in cases:
+            dx = base.weak_layer_thickness / n
             t0 = time.perf_counter()
-            rr = mw.run("shear_test", device=device, overrides=[f"scene.dx={dx!r}", *over])
+            rr = mw.run("shear_test", device=device, overrides=[f"scene.dx={dx!r}", f"scene.sample_length={Ls!r}",
+                                                                 *over])
             mon = rr.monitor
             c = shear_curves(mon.params, mon.times, {k: np.asarray(v) for k, v in mon.series.items()})
             res = rr.scene_result
-            runs.append({"cells": n, "dx": dx, "wall_s": time.perf_counter() - t0, "steps": rr.steps,
+            runs.append({"cells": n, "dx": dx, "sample_length": Ls, "wall_s": time.perf_counter() - t0,
+                         "steps": rr.steps,
                          "peak_shear_stress": res["peak_shear_stress"], "tau_p": res["tau_p_calibrated"],
                          "peak_over_tau_p": res["peak_shear_stress"] / res["tau_p_calibrated"],
                          "residual_shear_stress": res["residual_shear_stress"],
@@ -201,7 +206,8 @@ def main(argv=None) -> int:
         print(f"cost per particle-step, closure on / off: {data['cost']['ratio_on_over_off']:.3f}")
     for label, runs in ((k, v) for k, v in (data.get("shear") or {}).items() if k in ("off", "on")):
         for r in runs:
-            print(f"shear test, closure {label}, {r['cells']} cells: peak / tau_p = {r['peak_over_tau_p']:.4f}")
+            print(f"shear test, closure {label}, {r['cells']} cells, sample {r.get('sample_length')} m: peak / tau_p = "
+                  f"{r['peak_over_tau_p']:.4f}")
     return 0
 
 
