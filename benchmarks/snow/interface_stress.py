@@ -3,19 +3,19 @@
 The settled column (:mod:`mpm_warp.studies.interface_column`: ``pst_demo``'s substratum, 3 cm weak layer and
 slab between slip walls, settled as the PST settles) at 3, 4, 6, 12 and 24 cells across the layer: each
 particle row's ``sigma_yy`` beside the overburden at its height, without and with ``scene.interface_closure``
-(docs/model.md §5b). Part ``free``: ``pst_demo`` itself settled (free ends), the particle column at
-x = 2.1 m. Part ``shear``: the shear test's peak against the given tau_p at 4 and 8 cells (and at 4 on a sample twice as
-long), without and with. Part
-``model1d``: the same column as a 1D static problem (:mod:`mpm_warp.studies.interface_model1d`), plain, with
-B-bar-like averaging per cell and layer, and with the closure. Part ``cost``: CPU time per particle-step of
-``pst_demo`` while settling, without and with the closure. Part ``ladder``: the PST ladder's two coarsest
-levels (``pst_flat`` as the error ladder runs it), without and with. Parts run apart are merged into the file.
-Writes ``benchmarks/snow/results/interface_stress_<dev>.json`` and ``.png`` (sigma_yy / overburden per row
-against the height above the layer's base).
+(docs/model.md §5b). The other parts, each without and with the closure: ``model1d``, the same column as a 1D
+static problem (:mod:`mpm_warp.studies.interface_model1d`; also B-bar-like averaging per cell and layer);
+``free``, ``pst_demo`` itself settled (free ends), the particle column at x = 2.1 m; ``pst``, ``pst_demo``
+running, the rows 0.1 m ahead of its damage front once it has passed 1.2 m (the saw stops at 0.6 m);
+``shear``, the shear test's peak against the given tau_p at 4 and 8 cells (and at 4 on a sample twice as
+long); ``cost``, CPU time per particle-step of ``pst_demo`` while settling; ``ladder`` (not by default), the PST
+ladder's two coarsest levels (``pst_flat`` as the error ladder runs it). Parts run apart are merged into the
+file. Writes ``benchmarks/snow/results/interface_stress_<dev>.json`` and ``.png`` (sigma_yy / overburden per
+row against the height above the layer's base).
 
 Usage::
 
-    .venv/bin/python benchmarks/snow/interface_stress.py [--parts column model1d free shear cost ladder] [--quick]
+    .venv/bin/python benchmarks/snow/interface_stress.py [--parts column model1d free pst shear cost ladder] [--quick]
 """
 
 from __future__ import annotations
@@ -32,14 +32,16 @@ from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.shear_test import shear_curves
 from mpm_warp.studies import interface_model1d
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.interface_column import column_rows, free_column_rows, step_cost
+from mpm_warp.studies.interface_column import column_rows, free_column_rows, running_rows, step_cost
 from mpm_warp.studies.protocol import out_dir, parser, result_name
 from mpm_warp.studies.snow import PST_BRACKET, PST_DX, ladder_pst
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 CELLS = (3, 4, 6, 12, 24)
 SHEAR_CELLS = (4, 8)
-PARTS = ("column", "model1d", "free", "shear", "cost", "ladder")
+PARTS = ("column", "model1d", "free", "pst", "shear", "cost", "ladder")
+#: the running PST: the rows this far (m) ahead of the damage front, once it has passed this (m) from the cut end
+PST_AHEAD, PST_FRONT = 0.1, 1.2
 #: the PST ladder's two coarsest levels (3 and 6 cells across its 6 cm layer)
 LADDER_DX = PST_DX[:2]
 ON = "scene.interface_closure=true"
@@ -102,6 +104,11 @@ def ladder_part(device: str) -> dict:
                            "steps": int(sum(t["steps"] for t in res.trials))})
         out[label] = levels
     return out
+
+
+def pst_part(device: str) -> dict:
+    return {label: _slim(running_rows("pst_demo", over, ahead=PST_AHEAD, min_front=PST_FRONT, device=device))
+            for label, over in (("off", ()), ("on", (ON,)))}
 
 
 def free_part(device: str) -> dict:
@@ -182,7 +189,8 @@ def main(argv=None) -> int:
             data = {**json.load(f), **data}
     run = {"column": lambda: column_part(cells, a.device), "model1d": lambda: model1d_part(cells),
            "free": lambda: free_part(a.device), "shear": lambda: shear_part(SHEAR_CELLS, a.device),
-           "cost": lambda: cost_part(a.device), "ladder": lambda: ladder_part(a.device)}
+           "cost": lambda: cost_part(a.device), "ladder": lambda: ladder_part(a.device),
+           "pst": lambda: pst_part(a.device)}
     for part in parts:
         t0 = time.perf_counter()
         data[part] = run[part]()

@@ -22,7 +22,7 @@ from ..simulation import Simulation
 from ..walls import Wall
 
 __all__ = ["column_scenario", "overburden", "settled_rows", "column_rows", "free_column_rows", "row_ratios",
-           "step_cost"]
+           "step_cost", "running_rows"]
 
 
 def column_scenario(cells: float, scenario: str = "pst_demo", width_cells: int = 4, overrides=()):
@@ -184,3 +184,38 @@ def step_cost(scenario: str = "pst_demo", overrides=(), steps: int = 200, repeat
     return {"scenario": scenario, "overrides": list(overrides), "particles": int(n), "steps": steps,
             "repeats": repeats, "closure_particles": int(sum(len(a[0]) for a in sim.stepper._closure_arrays)),
             "s_per_particle_step": best / (steps * n)}
+
+
+def running_rows(scenario: str = "pst_demo", overrides=(), ahead: float = 0.1, min_front: float = 0.3,
+                 device: str = "cpu") -> dict:
+    """A running PST's rows just ahead of its damage front: ``sigma_yy`` and ``tau`` per row of the particle
+    column ``ahead`` (m) beyond the front, at the first frame the front has passed ``min_front`` (m) from the
+    cut end (the run stops there). Heights are initial; the overburden is the settled column's."""
+    from ..runner import run
+
+    state = {}
+
+    def frame(sim, k):
+        mon = sim.monitors["pst"]
+        front = mon.damage_front(sim.time)
+        if front >= min_front:
+            state.update(sim=sim, front=front, t=sim.time)
+            return False
+        return True
+
+    t0 = time.perf_counter()
+    rr = run(scenario, device=device, overrides=list(overrides), callback=frame)
+    wall = time.perf_counter() - t0
+    if "sim" not in state:
+        return {"front": float("nan"), "rows": [], "near": [], "wall_s": wall, "note": "the front did not pass "
+                f"{min_front} m"}
+    sim = state["sim"]
+    p = sim.scenario.scene
+    x_front = state["front"] if p.saw.cut_from == "upslope" else p.length - state["front"]
+    x = x_front + (ahead if p.saw.cut_from == "upslope" else -ahead)
+    h = p.dx / p.particles_per_cell
+    x0 = sim.x0[:, 0]
+    xc = x0[np.argmin(np.abs(x0 - x))]
+    rows = settled_rows(sim, (xc - 0.5 * h, xc + 0.5 * h))
+    return {"front": float(state["front"]), "t": float(state["t"]), "x": float(xc), "rows": rows,
+            "near": row_ratios(rows, p), "wall_s": wall, "steps": int(rr.steps)}

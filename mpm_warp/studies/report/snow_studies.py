@@ -204,6 +204,16 @@ def render_interface_stress(data: dict, ctx) -> list[str]:
         out += table(["layer", "initial height (mm)", "sigma_yy off (Pa)", "sigma_yy on (Pa)", "overburden (Pa)"],
                      rows)
         out += ["", env_note(fr), ""]
+    ps = data.get("pst")
+    if ps and ps["off"].get("near") and ps["on"].get("near"):
+        a, b = ps["off"], ps["on"]
+        rows = [[x["group"], fx(x["y0"], 2, 1e3), fx(x["sigma_yy"], 0), fx(y["sigma_yy"], 0), fx(x["tau"], 0),
+                 fx(y["tau"], 0), fx(x["overburden"], 0)] for x, y in zip(a["near"], b["near"], strict=True)]
+        out += [f"`pst_demo` running: the rows {fx(a['x'] - a['front'], 2)} m ahead of the damage front (off: front "
+                f"{fx(a['front'], 2)} m at {fx(a['t'], 3)} s; on: {fx(b['front'], 2)} m at {fx(b['t'], 3)} s):", ""]
+        out += table(["layer", "initial height (mm)", "sigma_yy off (Pa)", "sigma_yy on (Pa)", "tau off (Pa)",
+                      "tau on (Pa)", "overburden at rest (Pa)"], rows)
+        out += ["", env_note(ps), ""]
     sh = data.get("shear")
     if sh:
         rows = [[fx(a["cells"], 0), fx(a.get("sample_length"), 2), fx(a["peak_shear_stress"], 0),
