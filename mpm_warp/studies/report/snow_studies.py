@@ -263,10 +263,13 @@ def _ladder(lad: dict, ctx) -> list[str]:
         for k, label, _, _ in _LADDER_Q:
             moves = []
             for a, b in zip(lad["off"], lad["on"], strict=True):
+                cells = f"{fx(a['cells_across_layer'], 0)} cells: "
                 if finite(a.get(k)) and finite(b.get(k)) and finite(ref.get(k)):
-                    closer = abs(b[k] - ref[k]) < abs(a[k] - ref[k])
-                    moves.append(f"{fx(a['cells_across_layer'], 0)} cells: "
-                                 + ("towards" if closer else "away from") + " the finest level")
+                    da, db = abs(a[k] - ref[k]), abs(b[k] - ref[k])
+                    moves.append(cells + ("unchanged" if abs(b[k] - a[k]) <= 1e-9 * abs(a[k]) else
+                                          "towards the finest level" if db < da else "away from the finest level"))
+                elif finite(b.get(k)) and not finite(a.get(k)):
+                    moves.append(cells + "measured with the closure only (the run without it has none)")
             if moves:
                 out.append(f"- {label.split(' (')[0]}: " + "; ".join(moves) + ".")
         out.append("")
