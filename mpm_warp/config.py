@@ -79,6 +79,10 @@ class Block:
     halfspaces : tuple of (dim + 1,) float
         Planes that also bound the block: ``(n_x, n_y[, n_z], c)`` keeps the lattice points with
         ``n . x <= c`` (m); e.g. the slanted ends of a PST column with vertical faces. Empty: the box.
+    interface_normal : int
+        The axis normal to the layers of a laterally uniform stack the block is part of (every block naming the
+        same axis): where a grid cell mixes the stack's materials its particles take the laminate closure
+        (docs/model.md §5b). -1 (the default): none.
     """
 
     material: str
@@ -88,6 +92,7 @@ class Block:
     particles_per_cell: int = 2
     name: str = ""
     halfspaces: tuple = ()
+    interface_normal: int = -1
 
     def inside(self, x):
         """Mask (n,) of the points ``x`` (n, dim) (m) inside every one of :attr:`halfspaces`."""
@@ -286,6 +291,8 @@ class Scenario:
             if callable(b.velocity):
                 # a Python velocity field cannot be serialised; the state (checkpoints) carries it
                 bd["velocity"] = [0.0] * self.domain.dimension
+            if b.interface_normal < 0:
+                del bd["interface_normal"]  # not written when off: the files of scenes without it are unchanged
             d["blocks"].append(bd)
         if self.scene is not None:
             d["scene"] = {"kind": self.scene.kind, **self.scene.to_dict()}
@@ -361,7 +368,8 @@ def _block(b: Block, i: int, mats: dict, dom: Domain) -> Block:
     for k, h in enumerate(hs):
         if all(c == 0.0 for c in h[:-1]):
             raise InvalidArgument(f"{w}.halfspaces[{k}]", h, "a plane with a non-zero normal")
-    return Block(b.material, blo, bhi, vel, ppc, b.name or f"block{i}", hs)
+    normal = positive_int(f"{w}.interface_normal", b.interface_normal, lo=-1, hi=dim - 1)
+    return Block(b.material, blo, bhi, vel, ppc, b.name or f"block{i}", hs, normal)
 
 
 def _flag(field: str, value) -> bool:

@@ -15,9 +15,11 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import warp as wp
 
+from .interfaces import closure_factors
 from .kernels.crack_band import column_sums_zero_kernel, kappa_column_mean_kernel, kappa_column_sum_kernel
 from .kernels.g2p import g2p_kernel
 from .kernels.grid_update import grid_update_kernel, wall_state_kernel
+from .kernels.interface_closure import closure_kernel
 from .kernels.p2g import p2g_kernel
 from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec
@@ -143,6 +145,17 @@ class Stepper:
                     inputs=[s.x[sl], s.v[sl], s.C[sl], s.H[sl], hz, ljp, kap, yld, T(g.mass), T(g.vol0), m_par,
                             self.dt, origin, inv_dx, dx, shape, strides, *self._grid_copies[k], self.counts[k]],
                     device=dev, record_cmd=True))
+        # the laminate closure at material interfaces (docs/model.md §5b): only for stacks, before every P2G
+        self._closure, self._closure_arrays = [], []
+        F3 = wp.types.vector(3, T)
+        for axis, idx, fac in closure_factors(model):
+            if len(idx) == 0:
+                continue
+            arrays = (wp.array(idx, dtype=wp.int32, device=dev), wp.array(fac.astype(model.np_dtype), dtype=F3,
+                                                                           device=dev))
+            self._closure_arrays.append(arrays)
+            self._closure.append(wp.launch(closure_kernel(dim, T), len(idx), inputs=[*arrays, axis, s.C, self.dt],
+                                           device=dev, record_cmd=True))
         # walls at the end of the step, evaluated once per step for every node of the grid update
         self._wall_state = None
         wall_point = wall_velocity = None
@@ -203,7 +216,7 @@ class Stepper:
         """Every recorded launch of the plan (for compiling ahead of timing)."""
         walls = [self._wall_state] if self._wall_state is not None else []
         return [self._begin, *walls, *[k for ks in self._p2g for k in ks], *self._grid, *self._g2p,
-                *self._columns, self._end, *self.actions]
+                *self._columns, self._end, *self.actions, *self._closure]
 
     # ------------------------------------------------------------------ steps
     def _scatter(self, k: int) -> None:
@@ -219,6 +232,8 @@ class Stepper:
             self._wall_state.launch()
         for a in self.actions:
             a.launch()
+        for launch in self._closure:
+            launch.launch()
         if self._pool is None:
             self._scatter(0)
             self._grid[0].launch()

@@ -110,6 +110,7 @@ QUICK = {
     "convergence/error_vs_runtime_snow.py": ([], ["error_vs_runtime_snow_quick.json",
                                                   "error_vs_runtime_snow_quick.png"]),
     "snow/shear_test.py": ([], ["snow_shear_test_quick.json", "snow_shear_test_quick.png"]),
+    "snow/interface_stress.py": ([], ["interface_stress_cpu_quick.json", "interface_stress_cpu_quick.png"]),
 }
 
 

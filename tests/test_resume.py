@@ -162,3 +162,11 @@ def test_resume_on_another_thread_count(tmp_path):
     a, b = mw.read_run(str(tmp_path / "full.h5")), mw.read_run(part)
     assert res.steps + int(b.steps[3]) == full.steps      # the same step sizes: the speed bound carried over
     np.testing.assert_allclose(b.frame(-1)["x"], a.frame(-1)["x"], atol=1e-6)
+
+
+def test_pst_with_the_interface_closure_resumes_bit_for_bit(tmp_path):
+    """The closure's factors come from the initial positions (docs/model.md §5b), so a resume rebuilds them and
+    continues bit for bit."""
+    full, res, _ = _interrupted_equals_uninterrupted(tmp_path, "pst_demo", PST + ["scene.interface_closure=true"],
+                                                     0.055, ["weak_layer/ref"])
+    assert full.monitor.sim.stepper._closure and res.monitor.sim.stepper._closure

@@ -49,12 +49,13 @@ def build(params: PSTParams, time: TimeControl, output: Output | None = None, *,
                        p.plane_strain)
     halfspaces = _end_planes(p, box.dim)
     ppc = p.particles_per_cell
+    normal = 1 if p.interface_closure else -1  # the stack's axis: bed-normal
     materials, blocks = {}, []
 
     def add(group: str, material, y0: float, y1: float):
         materials[group] = material
         blocks.append(Block(group, box.corner(s_lo, y0), box.far_corner(L + s_hi, y1), particles_per_cell=ppc,
-                            name=group, halfspaces=halfspaces))
+                            name=group, halfspaces=halfspaces, interface_normal=normal))
 
     y = 0.0
     for group, layer in reversed(list(zip(layer_names("substratum", len(sub)), sub, strict=True))):

@@ -125,6 +125,11 @@ class PSTParams:
         The slab can break: each slab layer cracks in tension (:class:`~mpm_warp.materials.CrackingSnow`) at its
         tensile strength and fracture energy (given, or from its density), over a crack band of one particle
         spacing, ``dx / particles_per_cell``. False (the default): an elastic slab, at no extra cost.
+    interface_closure : bool
+        The laminate closure at the stack's interfaces (docs/model.md §5b): a particle whose grid cells mix two
+        layers' snow is strained as its layer in a laminate, so that the normal and shear stress are continuous
+        across the interfaces instead of the rows beside a stiffness jump carrying half or double the load. False
+        (the default): the plain MLS-MPM strain, at no extra cost.
     profile : ProfileSource
         The CAAML snow profile the layers come from (:mod:`.from_profile`; the loader reads it once and fills the
         layers); empty for a snowpack given in the file.
@@ -158,6 +163,7 @@ class PSTParams:
     slab_layers: tuple[SnowLayer, ...] = ()
     substratum_layers: tuple[SnowLayer, ...] = ()
     slab_fracture: bool = False
+    interface_closure: bool = False
     profile: ProfileSource = field(default_factory=ProfileSource)
 
     def validate(self, where: str = "scene") -> PSTParams:
@@ -178,6 +184,8 @@ class PSTParams:
             raise InvalidArgument(f"{where}.slab_fracture", self.slab_fracture, "true or false")
         if self.slab_fracture:
             self._check_crack_band(where)
+        if not isinstance(self.interface_closure, bool):
+            raise InvalidArgument(f"{where}.interface_closure", self.interface_closure, "true or false")
         finite_number(f"{where}.slope_angle", self.slope_angle, lo=-60.0, hi=60.0)
         finite_number(f"{where}.width", self.width, lo=0.0)
         check_plane_strain(self.plane_strain, self.width, where)
@@ -231,8 +239,12 @@ class PSTParams:
                     f"{mat.fracture_energy:.3g} J/m^2): wider, its softening snaps back"))
 
     def to_dict(self) -> dict:
-        """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back)."""
-        return asdict(self)
+        """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back; ``interface_closure``
+        only when on, so the files of scenes without it are unchanged)."""
+        d = asdict(self)
+        if not self.interface_closure:
+            del d["interface_closure"]
+        return d
 
     # ------------------------------------------------------------- the snowpack
     def slab_stack(self) -> tuple[SnowLayer, ...]:

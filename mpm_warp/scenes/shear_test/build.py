@@ -24,10 +24,11 @@ def build(params: ShearTestParams, time: TimeControl, output: Output | None = No
     cal = p.calibrated()
     materials = {"load": Elastic(p.slab.E, p.slab.nu, p.load_density), "weak_layer": cal.material}
     ppc = p.particles_per_cell
+    normal = 1 if p.interface_closure else -1  # the laminate closure's axis (docs/model.md §5b)
     blocks = (Block("weak_layer", box.corner(0.0, 0.0), box.far_corner(Ls, d_wl), particles_per_cell=ppc,
-                    name="weak_layer"),
+                    name="weak_layer", interface_normal=normal),
               Block("load", box.corner(0.0, d_wl), box.far_corner(Ls, d_wl + t_load), particles_per_cell=ppc,
-                    name="load"))
+                    name="load", interface_normal=normal))
     floor = Wall(box.vector(0.0, 0.0), box.vector(0.0, 1.0), kind="sticky", name="substratum")
     desc = description or (f"Shear test: {Ls * 100:g} cm x {d_wl * 100:g} cm weak layer under {sigma_n:.0f} Pa, "
                            f"wall at {p.wall_speed:g} m/s")

@@ -7,6 +7,7 @@ from dataclasses import asdict, dataclass, field
 from typing import ClassVar
 
 from ...checks import check_choices, finite_number, positive_int
+from ...errors import InvalidArgument
 from ..snow import GRAVITY, Settle, Slab, check_weak_layer_cells, slab_normal_stress
 from ..weak_layer import CalibratedWeakLayer, WeakLayer
 
@@ -60,6 +61,9 @@ class ShearTestParams:
         Slope (deg) of the PST whose slab load is reproduced, in [-60, 60].
     slab, weak_layer, settle
         :class:`SlabLoad`, :class:`~mpm_warp.scenes.weak_layer.WeakLayer`, :class:`~mpm_warp.scenes.snow.Settle`.
+    interface_closure : bool
+        The laminate closure at the layer's interface with the loading block (docs/model.md §5b; as the PST's
+        option). False (the default): the plain MLS-MPM strain.
     """
 
     kind: ClassVar[str] = "shear_test"
@@ -75,6 +79,7 @@ class ShearTestParams:
     slab: SlabLoad = field(default_factory=SlabLoad)
     weak_layer: WeakLayer = field(default_factory=WeakLayer)
     settle: Settle = field(default_factory=Settle)
+    interface_closure: bool = False
 
     def validate(self, where: str = "scene") -> ShearTestParams:
         """Check every value (InvalidArgument naming ``where.field``, the value and the range); return self."""
@@ -92,11 +97,17 @@ class ShearTestParams:
         self.slab.validate(f"{where}.slab")
         self.weak_layer.validate(f"{where}.weak_layer")
         self.settle.validate(f"{where}.settle")
+        if not isinstance(self.interface_closure, bool):
+            raise InvalidArgument(f"{where}.interface_closure", self.interface_closure, "true or false")
         return self
 
     def to_dict(self) -> dict:
-        """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back)."""
-        return asdict(self)
+        """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back; ``interface_closure``
+        only when on, so the files of scenes without it are unchanged)."""
+        d = asdict(self)
+        if not self.interface_closure:
+            del d["interface_closure"]
+        return d
 
     # ------------------------------------------------------------- derived values
     @property
