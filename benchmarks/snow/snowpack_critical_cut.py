@@ -107,7 +107,7 @@ def figure(data: dict, path: str) -> None:
     import matplotlib.pyplot as plt
 
     cases = data["cases"]
-    fig, ax = plt.subplots(figsize=(9, 1.4 + 0.5 * len(cases)))
+    fig, ax = plt.subplots(figsize=(9, 1.9 + 0.5 * len(cases)))
     for i, c in enumerate(cases.values()):
         for tr in c["trials"]:
             ax.plot(tr["cut"], i, "o" if tr["propagated"] else "x", color="C3" if tr["propagated"] else "C0", ms=6)
@@ -115,8 +115,12 @@ def figure(data: dict, path: str) -> None:
         if c["weac"].get("critical_cut"):
             ax.plot(c["weac"]["critical_cut"], i, "*", color="C2", ms=11, mfc="none")
     ax.set_yticks(range(len(cases)), list(cases))
-    ax.set(xlabel="saw cut length [m]", title="critical cut: x arrested, o propagated, bar = bracket, "
-                                             "star = weac (energy criterion, G = w_f)")
+    ax.set(xlabel="saw cut length [m]", title="critical cut of each column: the bisection's trials and weac")
+    handles = [ax.plot([], [], "x", color="C0", ms=6)[0], ax.plot([], [], "o", color="C3", ms=6)[0],
+               ax.plot([], [], "-", color="k", lw=3, alpha=0.4)[0],
+               ax.plot([], [], "*", color="C2", ms=11, mfc="none")[0]]
+    ax.legend(handles, ["arrested", "propagated", "bracket", "weac (energy criterion, G = w_f)"], loc="upper center",
+              bbox_to_anchor=(0.5, -0.16), ncols=4, fontsize=8, frameon=False)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
