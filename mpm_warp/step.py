@@ -10,6 +10,8 @@ steps is captured once as a graph and replayed.
 from __future__ import annotations
 
 import os
+import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -45,6 +47,10 @@ def grid_copies(device: str, n_particles: int, grid_shape, n_threads: int | None
         return 1
     nt = n_threads or default_threads(device, n_particles)
     return max(1, min(nt, grid_shape[0] // 3, max(1, n_particles // 1000)))
+
+
+def _no_wait() -> None:
+    """The meeting of a one-thread step: nothing to wait for."""
 
 
 def _chunks(start: int, end: int, n: int) -> list[tuple[int, int]]:
@@ -206,7 +212,8 @@ class Stepper:
         self._graph = None
         #: steps per captured CUDA graph (the driver asks for whole batches; steps past a frame end are no-ops)
         self.graph_batch = max(1, model.scenario.output.health_every)
-        self._pool = ThreadPoolExecutor(nt, thread_name_prefix="mpm_warp") if nt > 1 else None
+        self._pool = ThreadPoolExecutor(nt - 1, thread_name_prefix="mpm_warp") if nt > 1 else None
+        self._barrier = threading.Barrier(nt) if nt > 1 else None
         #: recorded launches (``.launch()``) run at the start of every step, after the step size is set
         #: (e.g. a saw advancing through a weak layer); add them before the first call of :meth:`steps`.
         self.actions: list = []
@@ -226,7 +233,8 @@ class Stepper:
         for launch in self._p2g[k]:
             launch.launch()
 
-    def _launch_step(self) -> None:
+    def _before_scatter(self) -> None:
+        """The serial launches before P2G: step size, walls, actions (saw, monitors), interface closure."""
         self._begin.launch()
         if self._wall_state is not None:
             self._wall_state.launch()
@@ -234,18 +242,102 @@ class Stepper:
             a.launch()
         for launch in self._closure:
             launch.launch()
-        if self._pool is None:
-            self._scatter(0)
-            self._grid[0].launch()
-            self._g2p[0].launch()
-        else:
-            n = self.n_threads
-            list(self._pool.map(self._scatter, range(n)))
-            list(self._pool.map(lambda k: self._grid[k].launch(), range(n)))
-            list(self._pool.map(lambda k: self._g2p[k].launch(), range(n)))
+
+    def _after_gather(self) -> None:
+        """The serial launches after G2P: the bonded layers' column means and the clock."""
         for launch in self._columns:
             launch.launch()
         self._end.launch()
+
+    def _thread_steps(self, k: int, n: int, record: list | None = None) -> None:
+        """Thread ``k``'s part of ``n`` steps: the parallel stages, with thread 0 also running the serial ones.
+
+        The threads meet at :attr:`_barrier` after the serial launches, P2G, the grid update and G2P (four
+        meetings a step, against three pool rounds). With ``record`` each thread appends
+        ``(k, stage, start, end)`` perf-counter times (:meth:`profile`).
+        """
+        stages = (("p2g", lambda: self._scatter(k)), ("grid", self._grid[k].launch), ("g2p", self._g2p[k].launch))
+        clock = time.perf_counter
+        wait = self._barrier.wait if self._barrier is not None else _no_wait
+        for _ in range(n):
+            if k == 0:
+                t0 = clock() if record is not None else 0.0
+                self._before_scatter()
+                if record is not None:
+                    record.append((k, "serial", t0, clock()))
+            wait()
+            for name, run in stages:
+                t0 = clock() if record is not None else 0.0
+                run()
+                if record is not None:
+                    record.append((k, name, t0, clock()))
+                wait()
+            if k == 0:
+                t0 = clock() if record is not None else 0.0
+                self._after_gather()
+                if record is not None:
+                    record.append((k, "serial", t0, clock()))
+
+    def _team_steps(self, n: int, record: list | None = None) -> None:
+        """``n`` steps on all threads: 1..n_threads-1 from the pool, thread 0 the caller (no hang on an error)."""
+        if self._pool is None:
+            self._thread_steps(0, n, record)
+            return
+        barrier = self._barrier
+        barrier.reset()
+
+        def worker(k):
+            try:
+                self._thread_steps(k, n, record)
+            except threading.BrokenBarrierError:
+                pass  # another thread failed: its error is the one raised
+            except BaseException:
+                barrier.abort()
+                raise
+
+        futures = [self._pool.submit(worker, k) for k in range(1, self.n_threads)]
+        try:
+            self._thread_steps(0, n, record)
+        except threading.BrokenBarrierError:
+            pass
+        except BaseException:
+            barrier.abort()
+            raise
+        finally:
+            for f in futures:
+                f.result()
+        if barrier.broken:
+            raise RuntimeError("the CPU step's threads stopped at a broken barrier")
+
+    def _launch_step(self) -> None:
+        self._team_steps(1)
+
+    def profile(self, n: int) -> dict:
+        """Wall seconds per step of each stage over ``n`` steps, on every thread (the CPU step's cost breakdown).
+
+        Returns ``serial`` (thread 0's launches outside the parallel stages, per step), and for ``p2g``,
+        ``grid`` and ``g2p``: ``wall`` (meeting to meeting on thread 0, synchronisation included) and
+        ``busy`` (each thread's own launches): ``wall - max(busy)`` is the cost of the meeting and of the
+        imbalance. The clock is advanced as by :meth:`steps`.
+        """
+        record: list = []
+        t0 = time.perf_counter()
+        self._team_steps(n, record)
+        total = time.perf_counter() - t0
+        nt = self.n_threads
+        busy = {s: [0.0] * nt for s in ("serial", "p2g", "grid", "g2p")}
+        for k, stage, a, b in record:
+            busy[stage][k] += (b - a) / n
+        # thread 0's stage walls: from its start of a stage to its start of the next one
+        marks = [(stage, a) for k, stage, a, _ in record if k == 0]
+        walls = {s: 0.0 for s in ("p2g", "grid", "g2p")}
+        for (stage, a), (_, nxt) in zip(marks, [*marks[1:], (None, t0 + total)], strict=True):
+            if stage in walls:
+                walls[stage] += (nxt - a) / n
+        out = {"threads": nt, "steps": n, "total": total / n, "serial": busy["serial"][0]}
+        for s in walls:
+            out[s] = {"wall": walls[s], "busy": busy[s]}
+        return out
 
     def steps(self, n: int) -> None:
         """Launch ``n`` steps without any host synchronisation.
@@ -265,8 +357,8 @@ class Stepper:
             for _ in range(n // self.graph_batch):
                 wp.capture_launch(self._graph)
             n = n % self.graph_batch
-        for _ in range(n):
-            self._launch_step()
+        if n > 0:
+            self._team_steps(n)
 
     def seed_vmax(self) -> None:
         """Set the speed bound of the next step from the particles' current speeds.
