@@ -6,6 +6,8 @@ one base run, :mod:`mpm_warp.scenes.pst.critical`) and writes ``benchmarks/snow/
 against outcome, with the bracket, beside Gaume et al. 2017's formula and weac's static critical cut):
 
 - ``flat``: ``pst_flat`` on a 3 m column;
+- ``flat_closure``: ``flat`` with the laminate closure at the layers' interfaces (``scene.interface_closure``,
+  docs/model.md §5b);
 - ``slope``: ``pst_slope`` (30 deg) on a 3 m column;
 - ``flat_saw_half``: ``flat`` with the saw at half speed (0.5 m/s);
 - ``ladder_saw_half``: the PST of the error-against-run-time ladder at 6 cells across its layer
@@ -50,6 +52,7 @@ COLUMN = ["scene.length=3.0", "scene.marker_spacing=0.1"]
 LADDER = ladder_pst(0.01)
 CASES = {
     "flat": ("pst_flat", COLUMN, dict(lo=0.1, hi=0.8, tol=0.02)),
+    "flat_closure": ("pst_flat", COLUMN + ["scene.interface_closure=true"], dict(lo=0.1, hi=0.8, tol=0.02)),
     "slope": ("pst_slope", COLUMN, dict(lo=0.05, hi=0.8, tol=0.02)),
     "flat_saw_half": ("pst_flat", COLUMN + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.8, tol=0.02)),
     "ladder_saw_half": ("pst_flat", LADDER + ["scene.saw.speed=0.5"], dict(lo=0.1, hi=0.7, tol=0.02)),
@@ -134,7 +137,8 @@ def figure(data: dict, path: str) -> None:
         if w is not None:
             ax.plot(w, i, "*", color="C1", ms=11)
     ax.axvspan(*FIELD_CUT, color="0.9", zorder=0)
-    labels = {"flat": "pst_flat (3 m column, 4 cells)", "slope": "pst_slope (3 m column, 4 cells)",
+    labels = {"flat": "pst_flat (3 m column, 4 cells)", "flat_closure": "pst_flat, interface closure",
+              "slope": "pst_slope (3 m column, 4 cells)",
               "flat_saw_half": "pst_flat, saw 0.5 m/s", "ladder_saw_half": "ladder, saw 0.5 m/s",
               "ladder_slope": "ladder, 30 deg, cut from the upslope end",
               "ladder_slope_cut_downslope_end": "ladder, 30 deg, cut from the downslope end"}
