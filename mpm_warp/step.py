@@ -25,6 +25,7 @@ from .kernels.interface_closure import closure_kernel
 from .kernels.p2g import p2g_kernel
 from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec
+from .meeting import MeetingPoint
 from .model import Model, State, material_params
 
 __all__ = ["Stepper", "default_threads", "grid_copies"]
@@ -53,6 +54,16 @@ def _no_wait() -> None:
     """The meeting of a one-thread step: nothing to wait for."""
 
 
+def _timed(record: list | None, k: int, stage: str, run) -> None:
+    """``run()``, appending ``(k, stage, start, end)`` perf-counter times to ``record`` unless it is None."""
+    if record is None:
+        run()
+        return
+    t0 = time.perf_counter()
+    run()
+    record.append((k, stage, t0, time.perf_counter()))
+
+
 def _chunks(start: int, end: int, n: int) -> list[tuple[int, int]]:
     """Split ``[start, end)`` into ``n`` contiguous near-equal ranges."""
     edges = np.linspace(start, end, n + 1).round().astype(int)
@@ -62,11 +73,9 @@ def _chunks(start: int, end: int, n: int) -> list[tuple[int, int]]:
 class Stepper:
     """Launch plan for one model and state.
 
-    On the CPU a Warp launch runs on one thread, so the step is split over
-    ``n_threads`` Python threads (a launch releases the GIL): each thread
-    scatters its share of the particles into its own grid copy, the grid update
-    sums the copies slab by slab, and G2P gathers particle ranges. Atomics
-    never cross threads. On CUDA there is one grid copy and one launch per stage.
+    On the CPU the step is split over ``n_threads`` Python threads, each with its own grid copy
+    (docs/architecture.md, "The CPU step on several threads"). On CUDA there is one grid copy and
+    one launch per stage.
 
     Parameters
     ----------
@@ -213,7 +222,7 @@ class Stepper:
         #: steps per captured CUDA graph (the driver asks for whole batches; steps past a frame end are no-ops)
         self.graph_batch = max(1, model.scenario.output.health_every)
         self._pool = ThreadPoolExecutor(nt - 1, thread_name_prefix="mpm_warp") if nt > 1 else None
-        self._barrier = threading.Barrier(nt) if nt > 1 else None
+        self._barrier = MeetingPoint(nt) if nt > 1 else None
         #: recorded launches (``.launch()``) run at the start of every step, after the step size is set
         #: (e.g. a saw advancing through a weak layer); add them before the first call of :meth:`steps`.
         self.actions: list = []
@@ -252,31 +261,20 @@ class Stepper:
     def _thread_steps(self, k: int, n: int, record: list | None = None) -> None:
         """Thread ``k``'s part of ``n`` steps: the parallel stages, with thread 0 also running the serial ones.
 
-        The threads meet at :attr:`_barrier` after the serial launches, P2G, the grid update and G2P (four
-        meetings a step, against three pool rounds). With ``record`` each thread appends
-        ``(k, stage, start, end)`` perf-counter times (:meth:`profile`).
+        The threads meet (:class:`~mpm_warp.meeting.MeetingPoint`) after the serial launches, P2G, the grid
+        update and G2P. With ``record`` each thread appends ``(k, stage, start, end)`` times (:meth:`profile`).
         """
         stages = (("p2g", lambda: self._scatter(k)), ("grid", self._grid[k].launch), ("g2p", self._g2p[k].launch))
-        clock = time.perf_counter
         wait = self._barrier.wait if self._barrier is not None else _no_wait
         for _ in range(n):
             if k == 0:
-                t0 = clock() if record is not None else 0.0
-                self._before_scatter()
-                if record is not None:
-                    record.append((k, "serial", t0, clock()))
+                _timed(record, k, "serial", self._before_scatter)
             wait()
             for name, run in stages:
-                t0 = clock() if record is not None else 0.0
-                run()
-                if record is not None:
-                    record.append((k, name, t0, clock()))
+                _timed(record, k, name, run)
                 wait()
             if k == 0:
-                t0 = clock() if record is not None else 0.0
-                self._after_gather()
-                if record is not None:
-                    record.append((k, "serial", t0, clock()))
+                _timed(record, k, "serial", self._after_gather)
 
     def _team_steps(self, n: int, record: list | None = None) -> None:
         """``n`` steps on all threads: 1..n_threads-1 from the pool, thread 0 the caller (no hang on an error)."""

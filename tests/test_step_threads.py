@@ -85,3 +85,52 @@ def test_profile_adds_up(n_threads):
     for s in ("p2g", "grid", "g2p"):
         assert len(p[s]["busy"]) == n_threads
         assert 0.0 < max(p[s]["busy"]) <= p[s]["wall"] * 1.0001
+
+
+@pytest.mark.parametrize("spin_s", [0.0, 0.05])
+def test_meeting_point_meets_many_times_and_aborts_sleepers_and_pollers(spin_s):
+    """Three threads meet 200 times in order (each round's counter complete before the next); an abort then
+    releases a thread that waits, sleeping or polling, with BrokenBarrierError, and reset mends it."""
+    import threading
+
+    from mpm_warp.meeting import MeetingPoint
+
+    mp = MeetingPoint(3, spin_s=spin_s)
+    mp.spin_s = spin_s   # also poll with more parties than this machine's cores
+    seen = [[] for _ in range(3)]
+    counter = [0] * 200
+    lock = threading.Lock()
+
+    def party(k):
+        for r in range(200):
+            with lock:
+                counter[r] += 1
+            mp.wait()
+            seen[k].append(counter[r])
+
+    threads = [threading.Thread(target=party, args=(k,)) for k in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=30)
+    assert not any(t.is_alive() for t in threads)
+    assert all(s == [3] * 200 for s in seen)
+    caught = []
+
+    def waiter():
+        try:
+            mp.wait()
+        except threading.BrokenBarrierError:
+            caught.append(True)
+
+    t = threading.Thread(target=waiter)
+    t.start()
+    t.join(timeout=0.2)
+    assert t.is_alive()        # alone at the meeting: it waits
+    mp.abort()
+    t.join(timeout=5)
+    assert not t.is_alive() and caught == [True] and mp.broken
+    with pytest.raises(threading.BrokenBarrierError):
+        mp.wait()
+    mp.reset()
+    assert not mp.broken
