@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from .core import section
-from .fmt import count, env_note, fx, pct, table
+from .fmt import count, env_note, fx, pct, secs, table
 
 M = 1e-6      # particle-steps per second -> millions
 MS = 1e3      # seconds -> milliseconds
@@ -60,3 +60,24 @@ def render_pst_scaling(data: dict, ctx) -> list[str]:
                 "slower beside another's (which shared resource slows them is not measured). One profile of "
                 "200 steps per scene and thread count, after the rates.", "", env_note(entry), ""]
     return out[:-1]
+
+
+@section("perf", "`pst_flat` from its own command", "perf/results/pst_flat_wall_cpu.json",
+         "python benchmarks/perf/pst_flat_wall.py",
+         question="How long does the 8 m flat PST take on this 2-core CPU, and how fast was the machine that day?")
+def render_pst_flat_wall(data: dict, ctx) -> list[str]:
+    s = data["summary"]
+    work = s["n_particles"] * s["steps"]
+    out = table(["command", "wall time", "particles", "steps", "stepping (M particle-steps/s)",
+                 "elastic block before / after (M/s)"],
+                [[f"`{data['command']}`", secs(data["wall_s"]), count(s["n_particles"]), count(s["steps"]),
+                  fx(s["particle_steps_per_s"], 2, M),
+                  f"{fx(data['block_rate_before'], 2, M)} / {fx(data['block_rate_after'], 2, M)}"]])
+    out += ["", env_note(data), "",
+            f"- {fx(data['wall_s'] / 60, 1)} min, after a short run of the scene compiled its kernels; the command "
+            f"ran on {data['threads']} threads. Its {fx(work / 1e9, 1)} G particle-steps in 15 min would take "
+            f"{fx(work / 900, 1, M)} M particle-steps/s, {fx(work / 900 / s['particle_steps_per_s'], 2)}x the "
+            "rate it ran at.",
+            "- The elastic block (82,944 particles, 2 threads, 200 steps) was timed just before and just after the "
+            "run: this shared machine's speed on the day, against which a run on another day can be scaled."]
+    return out

@@ -229,6 +229,36 @@ def render_interface_stress(data: dict, ctx) -> list[str]:
     return out
 
 
+@section("snow", "The shear test's free ends", "snow/results/shear_free_ends_cpu.json",
+         "python benchmarks/snow/shear_free_ends.py", figure="snow/results/shear_free_ends_cpu.png",
+         question="Why does the shear test peak below tau_p: the interfaces, or the sample's free ends?")
+def render_shear_free_ends(data: dict, ctx) -> list[str]:
+    rows = []
+    for cells, runs in data["runs"].items():
+        for r in runs:
+            rows.append([cells, fx(r["sample_length"], 2), spct(r["peak_over_tau_p"] - 1.0),
+                         spct(r["interior_peak_over_tau_p"] - 1.0), secs(r["wall_s"])])
+        f = data["fit"][cells]
+        rows.append([cells, "endless (fit)", spct(f["a"] - 1.0), DASH, DASH])
+    out = ["The shear test against its sample's length: the structural peak (push force over the sample's area) and "
+           "the interior's own peak (the layer's mean `sigma_xy` at least one layer thickness from both ends, at its "
+           "maximum over time), both against the calibrated tau_p; the endless sample's peak from the fit "
+           "`a - b / L` of the structural peaks:", ""]
+    out += table(["cells", "sample length (m)", "structural peak", "interior's peak", "wall time"], rows)
+    out += ["", env_note(data), ""]
+    for cells, f in data["fit"].items():
+        out.append(f"- {cells} cells: the ends cost the peak {fx(1e3 * f['b'], 1)} mm of sample (largest residual of "
+                   f"the fit {pct(f['max_residual'], 2)} of tau_p).")
+    on = data.get("closure_on")
+    if on:
+        off = next((r for r in data["runs"].get("4", []) if abs(r["sample_length"] - on["sample_length"]) < 1e-9),
+                   None)
+        if off:
+            out.append(f"- The interface closure, 4 cells, {fx(on['sample_length'], 2)} m: structural peak "
+                       f"{spct(on['peak_over_tau_p'] - 1.0)} (off: {spct(off['peak_over_tau_p'] - 1.0)}).")
+    return out
+
+
 _LADDER_Q = (("critical_cut", "critical cut (m)", 3, 1.0), ("speed", "speed (m/s)", 1, 1.0),
              ("touchdown", "touchdown (m)", 3, 1.0), ("collapse_height", "collapse height (mm)", 2, 1e3))
 
