@@ -53,7 +53,7 @@ def figure(data: dict, path: str) -> None:
                 bx.plot(xa, [p["tau_over_tau_p"] for p in r["along"]], ".-",
                         label=f"{cells} cells, L = {r['sample_length']:g} m")
     ax.axhline(1.0, color="k", lw=0.8)
-    ax.axhspan(0.97, 1.03, color="0.9", zorder=0)
+    ax.axhspan(0.97, 1.03, color="0.9", zorder=0, label="within 3 % of tau_p")
     ax.set_xlim(left=0)
     ax.set_xlabel("1 / sample length (1/m)")
     ax.set_ylabel("peak shear stress / tau_p")

@@ -39,7 +39,8 @@ def shear_curves(params: ShearTestParams, times, series: dict) -> dict[str, np.n
 def analyze_shear_series(params: ShearTestParams, calibration, times, series: dict) -> dict:
     """Peak and residual strength, softening displacement and collapse of a shear test, with references.
 
-    On the layer's slip (:func:`shear_curves`): the peak and the residual of :func:`shear_summary`; the
+    On the layer's slip (:func:`shear_curves`): the peak and the residual of :func:`shear_summary`
+    (``interior_peak_shear_stress``: the largest mean ``sigma_xy`` of the layer's interior, Pa); the
     softening displacement ``delta_s`` is the slip from the peak to the loss of the bond (the mean bond of the
     layer's interior, at least ``D_wl`` from the sample's ends, at zero: the end of the strength drop, before
     the collapse and the frictional residual); the same on the block's displacement (``plate_``) for comparison
@@ -68,7 +69,11 @@ def analyze_shear_series(params: ShearTestParams, calibration, times, series: di
     # the debonded layer (cohesion beta b = 0) at the critical state: p0 = 2 p, p the Kirchhoff pressure
     cs = hardening_collapse(2.0 * p_end, mat.bulk, mat.xi, mat.p0_int_ini) \
         if np.isfinite(p_end) and p_end > 0 else math.nan
+    pushed = np.asarray(times, dtype=float) >= params.push_start - 1e-12
+    interior = np.asarray(series.get("interior_shear_stress", []), dtype=float)
+    interior = interior[pushed] if len(interior) == len(pushed) else np.array([math.nan])  # absent, or resumed
     return {"peak_shear_stress": sm.peak_stress, "residual_shear_stress": sm.residual_stress,
+            "interior_peak_shear_stress": float(np.max(interior)) if np.all(np.isfinite(interior)) else math.nan,
             "peak_slip": float(c["slip"][ip]),
             "softening_displacement": float(c["slip"][k] - c["slip"][ip]) if k >= 0 else math.nan,
             "softening_displacement_whole_layer":

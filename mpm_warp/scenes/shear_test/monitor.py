@@ -27,7 +27,10 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
     equals the substratum's shear reaction, by momentum balance), ``layer_shear_stress`` (Pa, mean
     Cauchy ``sigma_xy`` of the weak-layer particles from the device's stress field: lower, since the
     free ends carry none and part of the push reaches the layer's top through the shared grid
-    nodes), ``mises_q``/``p_mean`` (Pa, mean Mises stress and pressure of the weak layer, Cauchy), ``p_kirchhoff``
+    nodes), ``interior_shear_stress`` (Pa, the same over the layer's interior, at least one layer thickness
+    ``D_wl`` from both ends: the strength the material shows away from the traction-free ends, whose share
+    lowers the whole sample's peak as ``1/L_s``), ``mises_q``/``p_mean`` (Pa, mean Mises stress and pressure
+    of the weak layer, Cauchy), ``p_kirchhoff``
     (Pa, its mean Kirchhoff pressure, the yield function's),
     ``collapse`` (-, mean ``1 - J_P/J_P,ref`` of the layer), ``bond`` (-, the layer's mean bond
     ``1 - kappa/kappa_s``), ``bond_interior`` (-, the same away from the sample's ends: particles placed at
@@ -40,7 +43,8 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
     name = "shear_test"
     UNITS = {"shear_displacement": "m", "normal_displacement": "m", "layer_slip": "m", "shear_strain": "1",
              "axial_strain": "1",
-             "layer_shear_stress": "Pa", "shear_stress": "Pa", "mises_q": "Pa", "p_mean": "Pa", "p_kirchhoff": "Pa",
+             "layer_shear_stress": "Pa", "interior_shear_stress": "Pa", "shear_stress": "Pa", "mises_q": "Pa",
+             "p_mean": "Pa", "p_kirchhoff": "Pa",
              "collapse": "1",
              "bond": "1", "bond_interior": "1", "damaged_fraction": "1"}
 
@@ -97,7 +101,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
         return {"shear_displacement": float(u[0]), "normal_displacement": float(u[1]), "shear_stress": push,
                 "layer_slip": float(slip),
                 "shear_strain": float(u[0]) / d_wl, "axial_strain": -float(u[1]) / d_wl,
-                "layer_shear_stress": float(np.mean(sxy)),
+                "layer_shear_stress": float(np.mean(sxy)), "interior_shear_stress": float(np.mean(sxy[self.interior])),
                 "mises_q": float(np.mean(q[wl.start:wl.end])), "p_mean": float(np.mean(p[wl.start:wl.end])),
                 "p_kirchhoff": float(np.mean(p_k)),
                 "collapse": float(np.mean(c)), "bond": float(np.mean(bond)),

@@ -249,6 +249,13 @@ def render_shear_free_ends(data: dict, ctx) -> list[str]:
     for cells, f in data["fit"].items():
         out.append(f"- {cells} cells: the ends cost the peak {fx(1e3 * f['b'], 1)} mm of sample (largest residual of "
                    f"the fit {pct(f['max_residual'], 2)} of tau_p).")
+    for cells, runs in data["runs"].items():
+        r = max(runs, key=lambda x: x["sample_length"])
+        vals = [x["tau_over_tau_p"] for x in r["rows"]]
+        out.append(f"- Per particle row of the interior at the structural peak, {cells} cells, "
+                   f"{fx(r['sample_length'], 2)} m, bottom to top: " + ", ".join(spct(v - 1.0) for v in vals)
+                   + f" of tau_p (in uniform simple shear every row would carry the same; here they span "
+                   f"{pct(max(vals) - min(vals))} of tau_p).")
     on = data.get("closure_on")
     if on:
         off = next((r for r in data["runs"].get("4", []) if abs(r["sample_length"] - on["sample_length"]) < 1e-9),
