@@ -5,7 +5,8 @@ profile's PST, whose 5 mm grid resolves its thin weak layer, to 27k-108k) and a 
 and float64 and in every geometry the scene has (PST: true 2D, the quasi-2D slab
 ``plane_strain = "slab"`` and a 3D column ``width > 0``, also for the profile's PST with its cracking
 slab; shear test: 2D and 3D; the elastic block: its 3D box and a 2D one), the P2G variants a scene's
-materials and output select (the block of Cam-Clay snow, yield flags in the output), and the
+materials and output select (the block of Cam-Clay snow, yield flags in the output), the interface
+closure of a layered stack (``scene.interface_closure``), and the
 material-point driver (``mpm_warp.material_point``) for each material model in 2D and 3D.
 :func:`run_cases` runs each on the CPU, so that every kernel it needs is built, and
 records the Warp modules of the kernels it launched (every kernel is its own module,
@@ -72,6 +73,9 @@ _GEOMETRIES["pst_profile"] = {"2d": _PROFILE, "slab": _PROFILE + ["scene.plane_s
 #: the bonded weak layer's P2G with the yield flags (one PST scene: the three share their kernels)
 _PST_YIELDED = {"2d-yielded": _PST + ["output.fields=['x', 'log_jp', 'yielded']"],
                 "3d-yielded": _PST + ["scene.width=0.02", "output.fields=['x', 'log_jp', 'yielded']"]}
+#: the laminate closure at the layers' interfaces (one PST scene: the three share their kernels), 2D and 3D
+_PST_CLOSURE = {"2d-closure": _PST + ["scene.interface_closure=true"],
+                "3d-closure": _PST + ["scene.width=0.02", "scene.interface_closure=true"]}
 _SCENES = {"elastic_block": "elastic_block", "pst_demo": "pst", "pst_flat": "pst", "pst_slope": "pst",
            "pst_profile": "pst_profile", "shear_test": "shear_test"}
 PRECISIONS = ("float32", "float64")
@@ -94,7 +98,7 @@ def _cases() -> tuple[Case, ...]:
     out = []
     for prec in PRECISIONS:
         for scene, kind in _SCENES.items():
-            geometries = {**_GEOMETRIES[kind], **(_PST_YIELDED if scene == "pst_demo" else {})}
+            geometries = {**_GEOMETRIES[kind], **({**_PST_YIELDED, **_PST_CLOSURE} if scene == "pst_demo" else {})}
             for geo, ov in geometries.items():
                 out.append(Case(f"{scene}/{geo}/{prec}", prec, scene=scene,
                                 overrides=tuple(ov) + (f"precision='{prec}'",)))
