@@ -7,7 +7,8 @@ elastic block of the throughput benchmark at the same size (``n_grid`` 288: 82,9
 change in the machine's speed hits both alike. Then the breakdown: ``Stepper.profile`` over 200 steps
 of each scene (the PST while the saw cuts, after settling), per stage and thread: the serial launches
 (step size, walls, saw and monitors, column means, clock), P2G, the grid update and G2P, with each
-stage's wall time beside each thread's own work. Writes
+stage's wall time beside each thread's own work. At two threads, last, an interleaved A/B of the step's
+meeting point against ``threading.Barrier`` in the same stepper (8 batches of 100 steps each). Writes
 ``benchmarks/perf/results/pst_scaling_cpu.json``; the runs of one label (``--label``, default
 ``current``) replace that label's entry only, so a ``before`` run at an older commit stays beside.
 
@@ -72,6 +73,29 @@ def breakdown(sc, t_start: float, threads: int, steps: int) -> dict:
     return out
 
 
+def meeting_ab(sc, t_start: float, rounds: int = 8, steps: int = 100) -> dict:
+    """Interleaved A/B at two threads: the step's ``MeetingPoint`` against ``threading.Barrier`` (swapped in the
+    same stepper, same state), ``rounds`` batches of ``steps`` steps each in alternating order; medians (s)."""
+    import threading
+
+    sim = mw.Simulation(sc, device="cpu", n_threads=2)
+    attach(sim)
+    sim.step_to(t_start)
+    st = sim.stepper
+    st.set_frame_end(1e9)
+    kinds = {"meeting_point": st._barrier, "threading_barrier": threading.Barrier(st.n_threads)}
+    times = {k: [] for k in kinds}
+    for r in range(rounds):
+        for name in (list(kinds) if r % 2 == 0 else list(kinds)[::-1]):
+            st._barrier = kinds[name]
+            t0 = time.perf_counter()
+            st.steps(steps)
+            times[name].append((time.perf_counter() - t0) / steps)
+    st._barrier = kinds["meeting_point"]
+    med = {k: statistics.median(v) for k, v in times.items()}
+    return {"s_per_step": med, "times": times, "meeting_over_barrier": med["meeting_point"] / med["threading_barrier"]}
+
+
 def _pool_rounds(st, n: int) -> dict:
     """The same breakdown for the stepper before its threads met at a barrier (three pool rounds a step: the
     ``before`` entry, at commit bc28d92)."""
@@ -109,6 +133,14 @@ def _pool_rounds(st, n: int) -> dict:
     return out
 
 
+def _has_meeting_point() -> bool:
+    try:
+        import mpm_warp.meeting  # noqa: F401  (the step's threads meet there since commit b319260)
+    except ImportError:
+        return False
+    return True
+
+
 def main(argv=None) -> int:
     ap = parser(__doc__, "a 0.8 m PST and a 96^2 block over 0.02 s, one repeat")
     ap.add_argument("--label", default="current", help="name of this run's entry (e.g. before, after)")
@@ -124,6 +156,9 @@ def main(argv=None) -> int:
                                  / row["rates"]["elastic_block"]["particle_steps_per_s"])
         row["breakdown"] = {name: breakdown(sc, ts, nt, 20 if a.quick else PROFILE_STEPS)
                             for name, (sc, ts) in scs.items()}
+        if nt == 2 and _has_meeting_point():
+            row["meeting_ab"] = {name: meeting_ab(sc, ts, 2 if a.quick else 8, 20 if a.quick else 100)
+                                 for name, (sc, ts) in scs.items()}
         entry["threads"][str(nt)] = row
         print(f"{nt} thread(s): PST {row['rates']['pst_demo']['particle_steps_per_s'] / 1e6:.2f}, block "
               f"{row['rates']['elastic_block']['particle_steps_per_s'] / 1e6:.2f} M particle-steps/s, "

@@ -35,7 +35,7 @@ def _breakdown(entry: dict) -> list[list[str]]:
 
 
 @section("perf", "The PST step across threads, beside the elastic block", "perf/results/pst_scaling_cpu.json",
-         lambda d: f"python benchmarks/perf/pst_scaling.py --label {list(d['runs'])[-1]} --repeats "
+         lambda d: f"python benchmarks/perf/pst_scaling.py --label '{list(d['runs'])[-1]}' --repeats "
                    f"{next(iter(d['runs'].values()))['repeats']}",
          question="Does the PST's step scale from one thread to two like an elastic step, and where does its time go?")
 def render_pst_scaling(data: dict, ctx) -> list[str]:
@@ -58,7 +58,14 @@ def render_pst_scaling(data: dict, ctx) -> list[str]:
         out += ["", f"At two threads each thread's own P2G takes {fx(share['pst_demo'], 2)}x (PST) and "
                 f"{fx(share['elastic_block'], 2)}x (block) half the one-thread P2G: a thread's launches run "
                 "slower beside another's (which shared resource slows them is not measured). One profile of "
-                "200 steps per scene and thread count, after the rates.", "", env_note(entry), ""]
+                "200 steps per scene and thread count, after the rates."]
+        ab = entry["threads"]["2"].get("meeting_ab")
+        if ab:
+            out += ["", "The meeting point against `threading.Barrier` in the same stepper at two threads, "
+                    f"{len(ab['pst_demo']['times']['meeting_point'])} batches of each in turns: "
+                    + "; ".join(f"{name} {fx(ab[key]['meeting_over_barrier'], 3)}x the step time"
+                                for key, name in SCENES) + "."]
+        out += ["", env_note(entry), ""]
     return out[:-1]
 
 
