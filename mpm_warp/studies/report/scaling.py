@@ -36,7 +36,7 @@ def _breakdown(entry: dict) -> list[list[str]]:
 
 @section("perf", "The PST step across threads, beside the elastic block", "perf/results/pst_scaling_cpu.json",
          lambda d: f"python benchmarks/perf/pst_scaling.py --label '{list(d['runs'])[-1]}' --repeats "
-                   f"{next(iter(d['runs'].values()))['repeats']}",
+                   f"{list(d['runs'].values())[-1]['repeats']}",
          question="Does the PST's step scale from one thread to two like an elastic step, and where does its time go?")
 def render_pst_scaling(data: dict, ctx) -> list[str]:
     out = []
