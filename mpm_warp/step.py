@@ -50,8 +50,8 @@ def grid_copies(device: str, n_particles: int, grid_shape, n_threads: int | None
     return max(1, min(nt, grid_shape[0] // 3, max(1, n_particles // 1000)))
 
 
-def _no_wait() -> None:
-    """The meeting of a one-thread step: nothing to wait for."""
+def _no_wait() -> None:  # the meeting of a one-thread step: nothing to wait for
+    pass
 
 
 def _timed(record: list | None, k: int, stage: str, run) -> None:
@@ -284,7 +284,7 @@ class Stepper:
         barrier = self._barrier
         barrier.reset()
 
-        def worker(k):
+        def guarded(k):
             try:
                 self._thread_steps(k, n, record)
             except threading.BrokenBarrierError:
@@ -293,14 +293,9 @@ class Stepper:
                 barrier.abort()
                 raise
 
-        futures = [self._pool.submit(worker, k) for k in range(1, self.n_threads)]
+        futures = [self._pool.submit(guarded, k) for k in range(1, self.n_threads)]
         try:
-            self._thread_steps(0, n, record)
-        except threading.BrokenBarrierError:
-            pass
-        except BaseException:
-            barrier.abort()
-            raise
+            guarded(0)
         finally:
             for f in futures:
                 f.result()
@@ -326,12 +321,18 @@ class Stepper:
         busy = {s: [0.0] * nt for s in ("serial", "p2g", "grid", "g2p")}
         for k, stage, a, b in record:
             busy[stage][k] += (b - a) / n
-        # thread 0's stage walls: from its start of a stage to its start of the next one
-        marks = [(stage, a) for k, stage, a, _ in record if k == 0]
-        walls = {s: 0.0 for s in ("p2g", "grid", "g2p")}
-        for (stage, a), (_, nxt) in zip(marks, [*marks[1:], (None, t0 + total)], strict=True):
-            if stage in walls:
-                walls[stage] += (nxt - a) / n
+        # per step: first start of a stage to first start of the next (G2P: to thread 0's serial launches)
+        first: dict = {}
+        for k, stage, a, _ in record:
+            if stage != "serial" or k == 0:
+                first.setdefault((k, stage), []).append(a)
+        stages = ("p2g", "grid", "g2p")
+        ends = first[(0, "serial")][1::2]
+        walls = {s: 0.0 for s in stages}
+        for i in range(n):
+            b = [min(first[(j, s)][i] for j in range(nt)) for s in stages] + [ends[i]]
+            for m, s in enumerate(stages):
+                walls[s] += (b[m + 1] - b[m]) / n
         out = {"threads": nt, "steps": n, "total": total / n, "serial": busy["serial"][0]}
         for s in walls:
             out[s] = {"wall": walls[s], "busy": busy[s]}
