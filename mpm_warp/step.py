@@ -27,6 +27,7 @@ from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec
 from .meeting import MeetingPoint
 from .model import Model, State, material_params
+from .step_profile import stage_walls
 
 __all__ = ["Stepper", "default_threads", "grid_copies"]
 
@@ -316,27 +317,7 @@ class Stepper:
         record: list = []
         t0 = time.perf_counter()
         self._team_steps(n, record)
-        total = time.perf_counter() - t0
-        nt = self.n_threads
-        busy = {s: [0.0] * nt for s in ("serial", "p2g", "grid", "g2p")}
-        for k, stage, a, b in record:
-            busy[stage][k] += (b - a) / n
-        # per step: first start of a stage to first start of the next (G2P: to thread 0's serial launches)
-        first: dict = {}
-        for k, stage, a, _ in record:
-            if stage != "serial" or k == 0:
-                first.setdefault((k, stage), []).append(a)
-        stages = ("p2g", "grid", "g2p")
-        ends = first[(0, "serial")][1::2]
-        walls = {s: 0.0 for s in stages}
-        for i in range(n):
-            b = [min(first[(j, s)][i] for j in range(nt)) for s in stages] + [ends[i]]
-            for m, s in enumerate(stages):
-                walls[s] += (b[m + 1] - b[m]) / n
-        out = {"threads": nt, "steps": n, "total": total / n, "serial": busy["serial"][0]}
-        for s in walls:
-            out[s] = {"wall": walls[s], "busy": busy[s]}
-        return out
+        return stage_walls(record, n, self.n_threads, time.perf_counter() - t0)
 
     def steps(self, n: int) -> None:
         """Launch ``n`` steps without any host synchronisation.

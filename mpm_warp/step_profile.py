@@ -1,0 +1,53 @@
+"""The CPU step's cost breakdown from its threads' stage times (:meth:`mpm_warp.step.Stepper.profile`).
+
+Each thread of the step records ``(thread, stage, start, end)`` perf-counter times of its launches;
+this turns them into per-step wall and busy seconds per stage (docs/architecture.md, "The CPU step
+on several threads").
+"""
+
+from __future__ import annotations
+
+__all__ = ["stage_walls", "STAGES"]
+
+#: the parallel stages of a step, in order
+STAGES = ("p2g", "grid", "g2p")
+
+
+def stage_walls(record: list, n: int, n_threads: int, total: float) -> dict:
+    """Per-step seconds of each stage from ``record`` over ``n`` steps on ``n_threads`` threads.
+
+    Parameters
+    ----------
+    record : list of (int, str, float, float)
+        ``(thread, stage, start, end)`` times (s); ``stage`` one of ``"serial"`` (thread 0's launches
+        outside the parallel stages, twice a step) and :data:`STAGES`.
+    n : int
+        Steps recorded.
+    n_threads : int
+    total : float
+        Wall time of the ``n`` steps (s).
+
+    Returns
+    -------
+    dict
+        ``threads``, ``steps``, ``total`` (s per step), ``serial`` (s per step) and, per stage,
+        ``wall`` (first start of the stage on any thread to the first start of the next; G2P ends at
+        thread 0's serial launches) and ``busy`` (each thread's own launches, s per step).
+    """
+    busy = {s: [0.0] * n_threads for s in ("serial", *STAGES)}
+    for k, stage, a, b in record:
+        busy[stage][k] += (b - a) / n
+    first: dict = {}
+    for k, stage, a, _ in record:
+        if stage != "serial" or k == 0:
+            first.setdefault((k, stage), []).append(a)
+    ends = first[(0, "serial")][1::2]
+    walls = {s: 0.0 for s in STAGES}
+    for i in range(n):
+        b = [min(first[(j, s)][i] for j in range(n_threads)) for s in STAGES] + [ends[i]]
+        for m, s in enumerate(STAGES):
+            walls[s] += (b[m + 1] - b[m]) / n
+    out = {"threads": n_threads, "steps": n, "total": total / n, "serial": busy["serial"][0]}
+    for s in STAGES:
+        out[s] = {"wall": walls[s], "busy": busy[s]}
+    return out
