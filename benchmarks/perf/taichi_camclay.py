@@ -3,9 +3,10 @@
 The Cam-Clay return is the same algorithm as mpm_warp's (docs/model.md §4): the
 point of the yield ellipse closest to the trial ``(p, q)`` in the energy metric
 ``dp^2/K + dq^2/(3 mu)``, found in scaled coordinates by Eberly's
-parametrisation with Newton steps from the left end of the root bracket
-interleaved with bisection (the same stopping rule: ``0 <= f <= 4 eps`` or a
-bracket below ``4 eps (1 + s)``, at most 100 iterations), then
+parametrisation with Halley steps from the left end of the root bracket, Newton
+steps once one has passed the root, bisection after that (the same stopping
+rule: ``0 <= f <= 4 eps``, a bracket below ``4 eps (1 + s)``, no progress, at
+most 100 iterations), then
 ``log_Jp += tr eps_tr - tr eps_new`` and ``p0 = K sinh(xi max(-log_Jp, 0))``
 (explicit hardening).
 """
@@ -19,7 +20,7 @@ from mpm_warp.studies import plastic_block as pb
 
 #: Singular-value floor before ln (as mpm_warp's).
 S_FLOOR = 1.0e-6
-#: Newton/bisection iterations at most, and the float32 tolerance, of the ellipse root.
+#: Root iterations at most (Halley, Newton, bisection), and the float32 tolerance, of the ellipse root.
 MAX_ROOT_ITERATIONS = 100
 ROOT_EPS = 4.0 * 2.0**-23
 
@@ -42,53 +43,53 @@ def camclay_return_func(ti: Any, mu: float, K: float):
 
     @ti.func
     def ellipse_root_f(s, n0, r0, z1):
-        a = n0 / (s + r0)
-        b = z1 / (s + 1.0)
-        return ti.Vector([a * a + b * b - 1.0, -2.0 * (a * a / (s + r0) + b * b / (s + 1.0))])
+        """f, f', f'' and the reciprocals 1/(s + r0), 1/(s + 1)."""
+        i0 = 1.0 / (s + r0)
+        i1 = 1.0 / (s + 1.0)
+        a2 = (n0 * i0) * (n0 * i0)
+        b2 = (z1 * i1) * (z1 * i1)
+        return ti.Vector([a2 + b2 - 1.0, -2.0 * (a2 * i0 + b2 * i1), 6.0 * (a2 * i0 * i0 + b2 * i1 * i1), i0, i1])
 
     @ti.func
-    def ellipse_closest(e0, e1, y0, y1):
-        """Closest point of (x0/e0)^2 + (x1/e1)^2 = 1 to (y0, y1) >= 0, outside, e0 >= e1 > 0 (Eberly)."""
+    def ellipse_closest(e0, e1, ie0, ie1, y0, y1):
+        """Closest point of (x0/e0)^2 + (x1/e1)^2 = 1 to (y0, y1) >= 0, outside, e0 >= e1 > 0 (Eberly's
+        parametrisation; Halley, then Newton, then bisection steps from the bracket's lower end)."""
         res = ti.Vector([y0, y1])
         if y1 <= 0.0:
             res = ti.Vector([e0, 0.0])
         elif y0 <= 0.0:
             res = ti.Vector([0.0, e1])
         else:
-            z0 = y0 / e0
-            z1 = y1 / e1
+            z0 = y0 * ie0
+            z1 = y1 * ie1
             if z0 * z0 + z1 * z1 > 1.0:
-                r0 = (e0 / e1) * (e0 / e1)
+                r0 = (e0 * ie1) * (e0 * ie1)
                 n0 = r0 * z0
-                m = ti.max(n0, z1)
                 lo = ti.max(0.0, ti.max(z1 - 1.0, n0 - r0))
-                hi = ti.max(lo, m * ti.sqrt((n0 / m) * (n0 / m) + (z1 / m) * (z1 / m)) - 1.0)
+                hi = ti.max(lo, ti.sqrt(n0 * n0 + z1 * z1) - 1.0)
                 fd = ellipse_root_f(lo, n0, r0, z1)
-                f_lo = fd[0]
-                df_lo = fd[1]
+                mode = 2
                 it = 0
-                while it < max_it and f_lo > root_eps and hi - lo > root_eps * (1.0 + lo):
+                while it < max_it and fd[0] > root_eps and hi - lo > root_eps * (1.0 + lo):
                     it += 1
-                    s = lo
-                    if df_lo < 0.0:
-                        s = ti.min(ti.max(lo - f_lo / df_lo, lo), hi)
-                    fd = ellipse_root_f(s, n0, r0, z1)
-                    if fd[0] >= 0.0:
+                    f = fd[0]
+                    df = fd[1]
+                    den = 2.0 * df * df - f * fd[2]
+                    s = 0.5 * (lo + hi)
+                    if mode == 2 and den > 0.0:
+                        s = ti.min(lo - 2.0 * f * df / den, hi)
+                    elif mode >= 1 and df < 0.0:
+                        s = ti.min(lo - f / df, hi)
+                    if not s > lo:
+                        break
+                    fs = ellipse_root_f(s, n0, r0, z1)
+                    if fs[0] >= 0.0:
                         lo = s
-                        f_lo = fd[0]
-                        df_lo = fd[1]
+                        fd = fs
                     else:
                         hi = s
-                    if f_lo > root_eps and hi - lo > root_eps * (1.0 + lo):
-                        s = 0.5 * (lo + hi)
-                        fd = ellipse_root_f(s, n0, r0, z1)
-                        if fd[0] >= 0.0:
-                            lo = s
-                            f_lo = fd[0]
-                            df_lo = fd[1]
-                        else:
-                            hi = s
-                res = ti.Vector([r0 * y0 / (lo + r0), y1 / (lo + 1.0)])
+                        mode = ti.max(mode - 1, 0)
+                res = ti.Vector([(r0 * y0) * fd[3], y1 * fd[4]])
         return res
 
     @ti.func
@@ -116,11 +117,11 @@ def camclay_return_func(ti: Any, mu: float, K: float):
             xu = 0.0
             xv = 0.0
             if ti.static(c_axis <= 1.0):
-                r = ellipse_closest(1.0, c_axis, u, w)
+                r = ellipse_closest(1.0, c_axis, 1.0, 1.0 / c_axis, u, w)
                 xu = r[0]
                 xv = r[1]
             else:
-                r = ellipse_closest(c_axis, 1.0, w, u)
+                r = ellipse_closest(c_axis, 1.0, 1.0 / c_axis, 1.0, w, u)
                 xu = r[1]
                 xv = r[0]
             p_new = p0 - a * (1.0 - xu)
