@@ -32,10 +32,11 @@ def speed_profile_summary(res: dict, prefix: str) -> dict:
 
 
 def steady_speed(res: dict, slab_thickness: float, prefix: str = "damage") -> float | None:
-    """The median local speed (m/s) of one front's windows beyond :data:`~mpm_warp.studies.snow.STEADY_FROM` and
-    before the far end zone (one slab thickness); None on a column too short for it."""
+    """The median local speed (m/s) of one front's windows centred beyond :data:`~mpm_warp.studies.snow.STEADY_FROM`
+    and ending before the far end zone (one slab thickness), whose free edge speeds the crack up; None on a column
+    too short for it."""
     prof = res.get(f"{prefix}_speed_profile") or {"s": [], "speed": []}
-    end = (res.get("column_length") or 0.0) - slab_thickness
+    end = (res.get("column_length") or 0.0) - slab_thickness - 0.5 * SPEED_WINDOW
     v = sorted(v for s, v in zip(prof["s"], prof["speed"], strict=True) if STEADY_FROM <= s <= end and finite(v))
     if not v:
         return None

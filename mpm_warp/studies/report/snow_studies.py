@@ -90,6 +90,46 @@ def render_speed_trends(data: dict, ctx) -> list[str]:
     return out + [env_note(data)]
 
 
+@section("snow", "Steady crack speed on 8 m columns", "snow/results/snow_long_speed_trends.json",
+         "python benchmarks/snow/long_speed_trends.py", figure="snow/results/snow_long_speed_trends.png",
+         question="Beyond 5 m of an 8 m column, does the steady crack speed follow the slab's stiffness and the "
+                  "collapse height, and stay below the 0.6 c_s of long flat DEM PSTs? (One run per case, Dask tasks.)")
+def render_long_speed_trends(data: dict, ctx) -> list[str]:
+    t0 = data["trends"]
+    out = [f"The ladder PST's snow on an 8 m column ({_column(data)}), one run per case; the WEAC fit of h_c for "
+           f"this layer is {fx(t0.get('h_c_fit'), 2, 1e3)} mm. Steady: the median of the damage front's local speeds "
+           f"(0.5 m windows) centred beyond {fx(data.get('steady_from'), 0)} m and ending before the far end zone; "
+           "early: the mean over the first 3 m from the cut.", ""]
+    for param in ("slab.E", "weak_layer.h_c"):
+        t = t0[param]
+        label, key, scale, nd = _PARAMS.get(param, (param, "value", 1.0, 3))
+        rows = [[fx(c.get(key), nd, scale), fx(c.get("cut"), 1),
+                 "yes" if c.get("propagated") else f"no: the front stops at {fx(c.get('front'), 2)} m",
+                 fx(c.get("steady_speed"), 1), fx(c["steady_speed"] / c["shear_wave_speed"], 2)
+                 if finite(c.get("steady_speed")) else DASH, spct(c.get("steady_window_rise")),
+                 fx(c.get("early_speed"), 1),
+                 fx(c.get("collapse_height"), 2, 1e3), fx(c.get("heierli_speed_run"), 1), secs(c.get("wall_s"))]
+                for c in t["cases"]]
+        out += [f"`{param}`:", ""]
+        out += table([label, "cut (m)", "crack runs", "steady speed (m/s)", "steady / c_s",
+                      "change across the steady range", "early speed (m/s)",
+                      "collapse height (mm)", "Heierli, that collapse (m/s)", "wall time"], rows)
+        out += ["", f"Log-log slopes against `{param}`" + (" (the runs' collapse on the axis)" if param != "slab.E"
+                                                          else "") +
+                f": steady {fx(t.get('slope_steady'), 2)}, early {fx(t.get('slope_early'), 2)}, Heierli with the "
+                f"runs' collapse {fx(t.get('slope_heierli'), 2)} (closed form {t.get('heierli_exponent'):+g}).", ""]
+    out.append(f"- The fastest steady crack runs at {fx(t0.get('max_steady_over_cs'), 2)} c_s; long flat DEM PSTs "
+               "reach at most 0.6 c_s (Bobillier et al. 2024).")
+    cases = {c["finished_at"]: c for t in (t0["slab.E"], t0["weak_layer.h_c"]) for c in t["cases"]
+             if c.get("finished_at")}
+    if data.get("cases_from_earlier_run") and cases:
+        out.append(f"- {data['cases_from_earlier_run']} cases come from an earlier invocation, finished between "
+                   f"{min(cases)[:16].replace('T', ' ')} and {max(cases)[:16].replace('T', ' ')} UTC"
+                   + ("" if all(c.get("environment") for c in cases.values()) else
+                      " (their load is not on record: the wall times are not from a quiet machine)") + ".")
+    return out + ["", env_note(data)]
+
+
 # ----------------------------------------------------------------------------- weac
 @section("snow", "weac's static answers for the ladder PST", "snow/results/weac_static_pst.json",
          "python benchmarks/snow/weac_static_pst.py",
