@@ -35,7 +35,6 @@ import time
 
 import numpy as np
 
-from mpm_warp.scenes.pst.analysis import SPEED_WINDOW
 from mpm_warp.studies.convergence import loglog_slope
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.fanout import dask_map
@@ -83,15 +82,13 @@ def one_case(param: str, value: float, cut: float, device: str, column: list, fo
 
 def with_steady_speed(row: dict, length: float, slab_thickness: float) -> dict:
     """``row`` with its ``steady_speed`` (m/s; None on a column too short) from its stored speed profile, on a
-    column of ``length`` under a slab of ``slab_thickness`` (m)."""
-    from mpm_warp.studies.report.snow_runs import steady_speed
+    column of ``length`` under a slab of ``slab_thickness`` (m), and how far from steady it is: the change from
+    the first to the last steady window over that speed."""
+    from mpm_warp.studies.report.snow_runs import steady_speed, steady_windows
 
     res = {"damage_speed_profile": row["speed_profile"], "column_length": length}
-    prof = row["speed_profile"]
-    inside = [v for x, v in zip(prof["s"], prof["speed"], strict=True)
-              if STEADY_FROM <= x <= length - slab_thickness - 0.5 * SPEED_WINDOW and np.isfinite(v)]
+    inside = steady_windows(res, slab_thickness)
     v = steady_speed(res, slab_thickness)
-    # how far from steady: the change from the first to the last window of the steady range, over the median
     rise = (inside[-1] - inside[0]) / v if v and len(inside) > 1 else None
     return {**row, "steady_speed": v, "steady_window_rise": rise}
 
@@ -130,13 +127,14 @@ def figure(data: dict, path: str) -> None:
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
     rows = {(r["param"], r["value"]): r for k in ("slab.E", "weak_layer.h_c") for r in data["trends"][k]["cases"]}
     ax = axes[0]
-    for i, r in enumerate(sorted(rows.values(), key=lambda r: (r["param"], r["value"]))):
+    ran = [r for r in sorted(rows.values(), key=lambda r: (r["param"], r["value"])) if r["propagated"]]
+    for i, r in enumerate(ran):  # an arrested case has no speed profile (it is marked on the right)
         p = r["speed_profile"]
         lab = (f"E {r['value'] / 1e6:g} MPa" if r["param"] == "slab.E" and r["value"] != 5e6 else
                "centre (E 5 MPa, h_c fit)" if r["param"] == "slab.E" else
-               f"h_c {r['h_c_calibrated'] * 1e3:.1f} mm")
-        ax.plot(p["s"], p["speed"], "-", color=f"C{i}", label=lab + ("" if r["propagated"] else " (arrested)"))
-    ax.axvspan(STEADY_FROM, 8.0 - 0.3 - 0.5 * SPEED_WINDOW, color="0.9",
+               f"h_c {r['h_c_calibrated'] * 1e3:.2f} mm")
+        ax.plot(p["s"], p["speed"], "-", color=f"C{i}", label=lab)
+    ax.axvspan(*data["steady_range"], color="0.9",
                label="steady range (window centres)")
     ax.set(xlabel="damage front position from the cut end [m]", ylabel="local crack speed (0.5 m windows) [m/s]",
            xlim=(0, 8))
@@ -200,10 +198,12 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     rows = dask_map(one_case, [(p, v, c, a.device, column, parts) for p, v, c in cases], a.workers, a.scheduler)
     import mpm_warp as mw
+    from mpm_warp.studies.report.snow_runs import steady_range
 
     p = mw.load_scenario("pst_flat", column).scene
     rows = [with_steady_speed(r, p.length, p.slab_thickness) for r in rows]
-    data = {"trends": trends(rows, h_fit), "column": column, "steady_from": STEADY_FROM, "free_run": FREE_RUN,
+    data = {"trends": trends(rows, h_fit), "column": column, "steady_from": STEADY_FROM,
+            "steady_range": steady_range(p.length, p.slab_thickness), "free_run": FREE_RUN,
             "wall_s": time.perf_counter() - t0, "case_wall_s": sum(r["wall_s"] for r in rows),
             "cases_from_earlier_run": sum(bool(r.get("from_earlier_run")) for r in rows),
             "environment": environment(a.device)}

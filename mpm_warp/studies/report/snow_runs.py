@@ -31,13 +31,23 @@ def speed_profile_summary(res: dict, prefix: str) -> dict:
     return out
 
 
-def steady_speed(res: dict, slab_thickness: float, prefix: str = "damage") -> float | None:
-    """The median local speed (m/s) of one front's windows centred beyond :data:`~mpm_warp.studies.snow.STEADY_FROM`
-    and ending before the far end zone (one slab thickness), whose free edge speeds the crack up; None on a column
-    too short for it."""
+def steady_range(column_length: float, slab_thickness: float) -> tuple[float, float]:
+    """Centres (m from the cut end) of the local-speed windows that count as steady: beyond
+    :data:`~mpm_warp.studies.snow.STEADY_FROM`, and the window ending before the far end zone (one slab
+    thickness), whose free edge speeds the crack up."""
+    return STEADY_FROM, column_length - slab_thickness - 0.5 * SPEED_WINDOW
+
+
+def steady_windows(res: dict, slab_thickness: float, prefix: str = "damage") -> list[float]:
+    """One front's local speeds (m/s) centred in :func:`steady_range`, in order along the column."""
     prof = res.get(f"{prefix}_speed_profile") or {"s": [], "speed": []}
-    end = (res.get("column_length") or 0.0) - slab_thickness - 0.5 * SPEED_WINDOW
-    v = sorted(v for s, v in zip(prof["s"], prof["speed"], strict=True) if STEADY_FROM <= s <= end and finite(v))
+    lo, hi = steady_range(res.get("column_length") or 0.0, slab_thickness)
+    return [v for s, v in zip(prof["s"], prof["speed"], strict=True) if lo <= s <= hi and finite(v)]
+
+
+def steady_speed(res: dict, slab_thickness: float, prefix: str = "damage") -> float | None:
+    """The median of :func:`steady_windows` (m/s); None on a column too short for it."""
+    v = sorted(steady_windows(res, slab_thickness, prefix))
     if not v:
         return None
     n = len(v)
