@@ -17,7 +17,9 @@ __all__ = [
     "SINGULAR_VALUE_FLOOR",
     "camclay_p0_func",
     "camclay_pq_func",
+    "camclay_project_axes_func",
     "camclay_project_func",
+    "ellipse_axes",
     "ellipse_point_func",
     "camclay_return_strain_func",
     "camclay_yield_func",
@@ -132,8 +134,10 @@ def camclay_pq_func(T):
 
 @functools.cache
 def _ellipse_closest_func(T):
-    """Closest point of the ellipse ``(x0/e0)^2 + (x1/e1)^2 = 1`` to ``(y0, y1)`` (docs/model.md §4); ``ie0``,
-    ``ie1`` are ``1/e0``, ``1/e1`` (the caller has them: one axis is 1).
+    """Closest point ``(x0, x1)`` of the ellipse ``(x0/e0)^2 + (x1/e1)^2 = 1`` to ``(y0, y1)`` (docs/model.md §4)
+    and the factors ``f0 = x0/y0``, ``f1 = x1/y1`` (0 on a zero coordinate); ``ie0``, ``ie1`` are ``1/e0``, ``1/e1``
+    (the caller has them: one axis is 1). The factors are the root's reciprocals ``r0/(s + r0)``, ``1/(s + 1)``:
+    a caller that needs ``x/y`` (the return's deviatoric scale) gets it without a division.
 
     First quadrant only (``y0, y1 >= 0``), ``e0 >= e1 >= 0``, the point outside or on the ellipse:
     ``x0 = r0 y0 / (s + r0)``, ``x1 = y1 / (s + 1)``, ``r0 = (e0/e1)^2``, with ``s >= 0`` the root of
@@ -159,15 +163,19 @@ def _ellipse_closest_func(T):
     @wp.func
     def ellipse_closest(e0: T, e1: T, ie0: T, ie1: T, y0: T, y1: T):
         if e1 <= T(0.0):  # degenerate ellipse: the segment [-e0, e0] x {0}
-            return wp.min(y0, e0), T(0.0)
+            x0 = wp.min(y0, e0)
+            f0 = T(1.0)
+            if y0 > e0:
+                f0 = e0 / y0
+            return x0, T(0.0), f0, T(0.0)
         if y1 <= T(0.0):  # on the major axis, outside: the vertex
-            return e0, T(0.0)
+            return e0, T(0.0), e0 / y0, T(0.0)
         if y0 <= T(0.0):  # on the minor axis, outside: the co-vertex
-            return T(0.0), e1
+            return T(0.0), e1, T(0.0), e1 / y1
         z0 = y0 * ie0
         z1 = y1 * ie1
         if z0 * z0 + z1 * z1 <= T(1.0):  # on the ellipse within rounding
-            return y0, y1
+            return y0, y1, T(1.0), T(1.0)
         r0 = (e0 * ie1) * (e0 * ie1)
         n0 = r0 * z0
         lo = wp.max(T(0.0), wp.max(z1 - T(1.0), n0 - r0))
@@ -186,7 +194,7 @@ def _ellipse_closest_func(T):
             if not s > lo:  # no progress within rounding
                 break
             fs, dfs, d2fs, i0s, i1s = root_f(s, n0, r0, z1)
-            if fs >= T(0.0):
+            if fs >= T(-eps):  # past the root by rounding only: that is the root too (and the loop ends)
                 lo = s
                 f = fs
                 df = dfs
@@ -196,9 +204,63 @@ def _ellipse_closest_func(T):
             else:  # past the root: Newton from the lower end cannot pass it but by rounding, bisection then
                 hi = s
                 mode = wp.max(mode - 1, 0)
-        return (r0 * y0) * i0, y1 * i1
+        return (r0 * y0) * i0, y1 * i1, r0 * i0, i1
 
     return ellipse_closest
+
+
+def ellipse_axes(K, mu, M, beta):
+    """Constants of a material's scaled yield ellipse (docs/model.md §4), in float64 for the material struct.
+
+    Parameters
+    ----------
+    K, mu : float
+        Bulk and shear modulus (Pa, > 0).
+    M, beta : float
+        Critical-state slope (> 0) and cohesion ratio (>= 0), (-).
+
+    Returns
+    -------
+    rho, inv_rho, c, inv_c : float
+        ``rho = sqrt(3 mu / K)`` (``q = a rho v``), ``1/rho``, the axis ratio ``c = M / (rho sqrt(1 + 2 beta))``
+        of the ellipse ``u^2 + v^2/c^2 = 1`` and ``1/c`` (-); the same formulas as :func:`ellipse_point_func`.
+    """
+    rho = math.sqrt(3.0 * float(mu) / float(K))
+    c = float(M) / (math.sqrt(1.0 + 2.0 * float(beta)) * rho)
+    return rho, 1.0 / rho, c, 1.0 / c
+
+
+@functools.cache
+def _ellipse_point_axes_func(T):
+    """``ellipse_point_axes(p_tr, q_tr, p0, beta, rho, inv_rho, c, inv_c) -> (p, q, xu, xv, a, sgn, fv)``: the
+    projection of :func:`ellipse_point_func` for the ellipse constants of :func:`ellipse_axes`, and
+    ``fv = xv / v``, the factor by which it scales ``q`` (``q = fv q_tr``)."""
+    closest = _ellipse_closest_func(T)
+
+    @wp.func
+    def ellipse_point_axes(p_tr: T, q_tr: T, p0: T, beta: T, rho: T, inv_rho: T, c: T, inv_c: T):
+        a = T(0.5) * p0 * (T(1.0) + beta)
+        pc = T(0.5) * p0 * (T(1.0) - beta)
+        ia = T(1.0) / a
+        du = p_tr - pc
+        u = wp.abs(du) * ia
+        v = (q_tr * ia) * inv_rho
+        xu = T(0.0)
+        xv = T(0.0)
+        fu = T(0.0)
+        fv = T(0.0)
+        if c <= T(1.0):
+            xu, xv, fu, fv = closest(T(1.0), c, T(1.0), inv_c, u, v)
+        else:
+            xv, xu, fv, fu = closest(c, T(1.0), inv_c, T(1.0), v, u)
+        p = p0 - a * (T(1.0) - xu)
+        sgn = T(1.0)
+        if du < T(0.0):  # measured from the nearer tip: exact there, even for beta >> 1
+            p = -beta * p0 + a * (T(1.0) - xu)
+            sgn = T(-1.0)
+        return p, a * rho * xv, xu, xv, a, sgn, fv
+
+    return ellipse_point_axes
 
 
 @functools.cache
@@ -209,39 +271,46 @@ def ellipse_point_func(T):
     metric ``dp^2/K + dq^2/(3 mu)`` (docs/model.md §4), for ``a = p0 (1 + beta)/2 > 0`` (the caller's
     check), with the scaled coordinates it was found in: ``(xu, xv)`` on the ellipse ``u^2 + v^2/c^2 = 1``
     (``u = |p - pc|/a``, ``v = q/(a rho)``, ``rho = sqrt(3 mu/K)``, ``c = M/(rho sqrt(1 + 2 beta))``) and
-    ``sgn`` = -1 when the point is measured from the tensile tip (``p_tr < pc``), +1 else. The one
-    projection of :func:`camclay_project_func` and of the bonded return (which needs the scaled point for
-    its homothety derivative).
+    ``sgn`` = -1 when the point is measured from the tensile tip (``p_tr < pc``), +1 else. The projection
+    of the bonded return (which needs the scaled point for its homothety derivative, and whose ``beta``
+    softens, so that it forms the axes per trial); Cam-Clay's hot path takes the constants from the
+    material (:func:`camclay_project_axes_func`).
     """
-    closest = _ellipse_closest_func(T)
+    point = _ellipse_point_axes_func(T)
 
     @wp.func
     def ellipse_point(p_tr: T, q_tr: T, p0: T, K: T, mu: T, M: T, beta: T):
-        a = T(0.5) * p0 * (T(1.0) + beta)
-        pc = T(0.5) * p0 * (T(1.0) - beta)
         rho = wp.sqrt(T(3.0) * mu / K)  # q = a rho v
         s12 = wp.sqrt(T(1.0) + T(2.0) * beta)
         w = T(1.0) / (s12 * rho)
         c = M * w
-        ic = T(1.0) / c
-        ia = T(1.0) / a
-        du = p_tr - pc
-        u = wp.abs(du) * ia
-        v = (q_tr * ia) * (s12 * w)
-        xu = T(0.0)
-        xv = T(0.0)
-        if c <= T(1.0):
-            xu, xv = closest(T(1.0), c, T(1.0), ic, u, v)
-        else:
-            xv, xu = closest(c, T(1.0), ic, T(1.0), v, u)
-        p = p0 - a * (T(1.0) - xu)
-        sgn = T(1.0)
-        if du < T(0.0):  # measured from the nearer tip: exact there, even for beta >> 1
-            p = -beta * p0 + a * (T(1.0) - xu)
-            sgn = T(-1.0)
-        return p, a * rho * xv, xu, xv, c, rho, a, sgn
+        p, q, xu, xv, a, sgn, fv = point(p_tr, q_tr, p0, beta, rho, s12 * w, c, T(1.0) / c)
+        return p, q, xu, xv, c, rho, a, sgn
 
     return ellipse_point
+
+
+@functools.cache
+def camclay_project_axes_func(T):
+    """Build ``camclay_project_axes(p_tr, q_tr, p0, beta, rho, inv_rho, c, inv_c) -> (p_new, q_new, scale)``.
+
+    :func:`camclay_project_func` for the ellipse constants of the material (:func:`ellipse_axes`), and
+    ``scale = min(q_new / q_tr, 1)`` (-), the factor of the deviatoric strain, from the root's reciprocal
+    instead of a division. Stress-free (and ``scale = 0``) for ``p0 <= 0``.
+    """
+    point = _ellipse_point_axes_func(T)
+
+    @wp.func
+    def camclay_project_axes(p_tr: T, q_tr: T, p0: T, beta: T, rho: T, inv_rho: T, c: T, inv_c: T):
+        p_new = T(0.0)
+        q_new = T(0.0)
+        scale = T(0.0)
+        if T(0.5) * p0 * (T(1.0) + beta) > T(0.0):
+            p_new, q_new, xu, xv, a, sgn, fv = point(p_tr, q_tr, p0, beta, rho, inv_rho, c, inv_c)
+            scale = wp.min(fv, T(1.0))
+        return p_new, q_new, scale
+
+    return camclay_project_axes
 
 
 @functools.cache

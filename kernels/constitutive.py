@@ -14,7 +14,7 @@ import math
 import warp as wp
 
 from .bonded_camclay import bonded_camclay_return_strain_func, bonded_p0_func
-from .camclay import camclay_p0_func, camclay_project_func, camclay_return_strain_func, camclay_yield_func
+from .camclay import camclay_p0_func, camclay_project_axes_func, camclay_return_strain_func, camclay_yield_func
 from .cracking import crack_func
 from .elasticity import hencky_strain_func
 from .logstrain import expm1_func, expm1_small_func, expm1_sym_func, log1p_func, log_strain_func
@@ -48,6 +48,11 @@ def material_struct(T):
     ``log_jp_ref`` (-): the hardening state of the material as placed, so that the plastic change of
     volume since then is ``exp(log_jp - log_jp_ref)`` (``log_jp`` starts at a consolidation's state,
     not at 0) and the Cauchy stress is ``tau / (J_E exp(log_jp - log_jp_ref))``.
+
+    Derived constants (the engine fills them from the fields above, ``mpm_warp.model.material_params``):
+    ``K`` (bulk modulus ``lam + 2 mu / 3``, Pa) and ``inv_K`` (1/Pa); ``ell_rho``, ``ell_inv_rho``, ``ell_c``,
+    ``ell_inv_c`` (-): Cam-Clay's scaled yield ellipse (``kernels.camclay.ellipse_axes``), so that a yielding
+    particle's return forms no square root or reciprocal of material constants.
     """
 
     @wp.struct
@@ -64,6 +69,12 @@ def material_struct(T):
         log_jp_ref: T
         t_strength: T
         t_fail: T
+        K: T
+        inv_K: T
+        ell_rho: T
+        ell_inv_rho: T
+        ell_c: T
+        ell_inv_c: T
 
     return MaterialParams
 
@@ -109,12 +120,11 @@ def _model_funcs(T, model):
     if model == "camclay":
         p0f = camclay_p0_func(T)
         ret = camclay_return_strain_func(T)
-        project = camclay_project_func(T)
+        project = camclay_project_axes_func(T)
 
         @wp.func
         def yield_check(p: T, q: T, lj: T, kappa: T, m: P):
-            K = m.lam + (T(2.0) / T(3.0)) * m.mu
-            p0 = p0f(lj, K, m.xi, m.p0_floor)
+            p0 = p0f(lj, m.K, m.xi, m.p0_floor)
             return yf(p, q, p0, m.M, m.beta), p0
 
         @wp.func
@@ -124,15 +134,15 @@ def _model_funcs(T, model):
 
         @wp.func
         def invariant_return(tr: T, r: T, p0: T, lj: T, kappa: T, m: P):
-            # camclay_return_strain's projection and bookkeeping, on the invariants
-            K = m.lam + T(2.0) / T(3.0) * m.mu
+            # camclay_return_strain's projection and bookkeeping, on the invariants, with the material's
+            # ellipse constants and the deviatoric scale from the projection (no division on the invariants)
             q_tr = T(sqrt6) * m.mu * r
-            p_new, q_new = project(-K * tr, q_tr, p0, K, m.mu, m.M, m.beta)
-            scale = T(0.0)
-            if q_tr > T(0.0):
-                scale = wp.min(q_new / q_tr, T(1.0))
-            m_new = -p_new / (T(3.0) * K)
-            return scale, T(3.0) * m_new, lj + tr - T(3.0) * m_new, kappa, int(1)
+            p_new, q_new, scale = project(-m.K * tr, q_tr, p0, m.beta, m.ell_rho, m.ell_inv_rho, m.ell_c,
+                                          m.ell_inv_c)
+            if q_tr <= T(0.0):
+                scale = T(0.0)
+            tr_new = -p_new * m.inv_K
+            return scale, tr_new, lj + tr - tr_new, kappa, int(1)
 
     else:
         bp0 = bonded_p0_func(T)
@@ -140,8 +150,7 @@ def _model_funcs(T, model):
 
         @wp.func
         def yield_check(p: T, q: T, lj: T, kappa: T, m: P):
-            K = m.lam + (T(2.0) / T(3.0)) * m.mu
-            p0, b = bp0(lj, kappa, K, m.xi, m.p0_floor, m.p_bond, m.kappa_s)
+            p0, b = bp0(lj, kappa, m.K, m.xi, m.p0_floor, m.p_bond, m.kappa_s)
             return yf(p, q, p0, m.M, m.beta * b), p0
 
         @wp.func
@@ -211,6 +220,7 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
     expm1_sym = expm1_sym_func(T, dim)
     expm1_small = expm1_small_func(T)
     sqrt6 = _SQRT6
+    third = 1.0 / 3.0  # a Python float: a multiply (a division by 3 stays a division without fast math)
 
     @wp.func
     def small_strain(H_tr: M, hzz: T, lj: T, kap: T, m: P):
@@ -231,14 +241,13 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
         yld = int(0)
         if wp.static(plastic):
             if ok != 0:
-                mean = tr / T(3.0)
+                mean = tr * T(third)
                 dev = eps - mean * wp.identity(dim, dtype=T)
                 dev2 = wp.ddot(dev, dev)
                 if wp.static(dim == 2):
                     dev2 = dev2 + (ezz - mean) * (ezz - mean)
                 r = wp.sqrt(dev2)
-                K = m.lam + (T(2.0) / T(3.0)) * m.mu
-                y, p0 = yield_check(-K * tr, T(sqrt6) * m.mu * r, lj, kap, m)
+                y, p0 = yield_check(-m.K * tr, T(sqrt6) * m.mu * r, lj, kap, m)
                 if y > T(0.0):
                     yld = 1
         return eps, ezz, tr, r, p0, ok, yld
@@ -258,8 +267,8 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
         scale, tr_new, lj_new, kap_new, y = invariant_return(tr, r, p0, lj, kap, m)
         if y == 0:  # inside the surface after all (rounding of the invariants): elastic
             return H_tr, hzz, T(2.0) * m.mu * eps + (m.lam * tr) * I, lj, kap, int(0), int(1)
-        mean = tr / T(3.0)
-        mean_new = tr_new / T(3.0)
+        mean = tr * T(third)
+        mean_new = tr_new * T(third)
         eps_new = scale * (eps - mean * I) + mean_new * I
         D = eps_new - eps
         Dzz = T(0.0)

@@ -18,7 +18,7 @@ import warp as wp
 
 from .config import Scenario
 from .errors import InvalidArgument
-from .kernels.camclay import SINGULAR_VALUE_FLOOR
+from .kernels.camclay import SINGULAR_VALUE_FLOOR, ellipse_axes
 from .kernels.constitutive import material_struct
 from .kernels.grid_update import wall_struct
 from .kernels.types import mat, vec
@@ -99,9 +99,13 @@ def material_params(material: Elastic, T):
     m.mu = T(material.mu)
     m.lam = T(material.lam)
     m.s_floor = T(SINGULAR_VALUE_FLOOR)
+    K = float(material.bulk)
+    m.K, m.inv_K = T(K), T(1.0 / K)
     if isinstance(material, (CamClaySnow, BondedCamClay)):
         m.M, m.beta, m.xi, m.p0_floor = T(material.M), T(material.beta), T(material.xi), T(material.p0_floor)
         m.log_jp_ref = T(material.initial_log_jp)
+        m.ell_rho, m.ell_inv_rho, m.ell_c, m.ell_inv_c = (T(x) for x in ellipse_axes(K, material.mu, material.M,
+                                                                                       material.beta))
     if isinstance(material, BondedCamClay):
         m.p_bond, m.kappa_s = T(material.p_bond), T(material.kappa_s)
     if isinstance(material, CrackingSnow):

@@ -88,7 +88,7 @@ def test_log1p_and_expm1_keep_tiny_arguments(precision):
         a[i] = lp(x[i])
         b[i] = em(x[i])
 
-    x = np.array([1e-12, -3e-9, 2e-6, -5e-4, 0.1, -0.5, 2.0], dtype=nt)
+    x = np.array([1e-12, -3e-9, 2e-6, -5e-4, 0.04, -0.0625, 0.0625, -0.0626, 0.1, -0.5, 2.0], dtype=nt)  # series edge
     a = wp.zeros(len(x), dtype=T, device=DEVICE)
     b = wp.zeros(len(x), dtype=T, device=DEVICE)
     wp.launch(k, len(x), inputs=[wp.array(x, dtype=T, device=DEVICE), a, b], device=DEVICE)

@@ -38,6 +38,7 @@ def camclay_return_func(ti: Any, mu: float, K: float):
     rho_m = math.sqrt(3.0 * mu / K)  # q = a rho_m v in the scaled coordinates
     c_axis = M_csl / (math.sqrt(1.0 + 2.0 * beta) * rho_m)
     sqrt6 = math.sqrt(6.0)
+    inv_3K = 1.0 / (3.0 * K)
     root_eps = ROOT_EPS
     max_it = MAX_ROOT_ITERATIONS
 
@@ -53,12 +54,13 @@ def camclay_return_func(ti: Any, mu: float, K: float):
     @ti.func
     def ellipse_closest(e0, e1, ie0, ie1, y0, y1):
         """Closest point of (x0/e0)^2 + (x1/e1)^2 = 1 to (y0, y1) >= 0, outside, e0 >= e1 > 0 (Eberly's
-        parametrisation; Halley, then Newton, then bisection steps from the bracket's lower end)."""
-        res = ti.Vector([y0, y1])
+        parametrisation; Halley, then Newton, then bisection steps from the bracket's lower end; a step past the
+        root by rounding only ends it), and the factors x0/y0, x1/y1 (the root's reciprocals)."""
+        res = ti.Vector([y0, y1, 1.0, 1.0])
         if y1 <= 0.0:
-            res = ti.Vector([e0, 0.0])
+            res = ti.Vector([e0, 0.0, e0 / y0, 0.0])
         elif y0 <= 0.0:
-            res = ti.Vector([0.0, e1])
+            res = ti.Vector([0.0, e1, 0.0, e1 / y1])
         else:
             z0 = y0 * ie0
             z1 = y1 * ie1
@@ -83,13 +85,13 @@ def camclay_return_func(ti: Any, mu: float, K: float):
                     if not s > lo:
                         break
                     fs = ellipse_root_f(s, n0, r0, z1)
-                    if fs[0] >= 0.0:
+                    if fs[0] >= -root_eps:
                         lo = s
                         fd = fs
                     else:
                         hi = s
                         mode = ti.max(mode - 1, 0)
-                res = ti.Vector([(r0 * y0) * fd[3], y1 * fd[4]])
+                res = ti.Vector([(r0 * y0) * fd[3], y1 * fd[4], r0 * fd[3], fd[4]])
         return res
 
     @ti.func
@@ -115,23 +117,22 @@ def camclay_return_func(ti: Any, mu: float, K: float):
             u = ti.abs(du) / a
             w = q_tr / (a * rho_m)
             xu = 0.0
-            xv = 0.0
+            fv = 0.0
             if ti.static(c_axis <= 1.0):
                 r = ellipse_closest(1.0, c_axis, 1.0, 1.0 / c_axis, u, w)
                 xu = r[0]
-                xv = r[1]
+                fv = r[3]
             else:
                 r = ellipse_closest(c_axis, 1.0, 1.0 / c_axis, 1.0, w, u)
                 xu = r[1]
-                xv = r[0]
+                fv = r[2]
             p_new = p0 - a * (1.0 - xu)
             if du < 0.0:
                 p_new = -beta * p0 + a * (1.0 - xu)
-            q_new = a * rho_m * xv
             scale = 0.0
             if q_tr > 0.0:
-                scale = ti.min(q_new / q_tr, 1.0)
-            m_new = -p_new / (3.0 * K)
+                scale = ti.min(fv, 1.0)  # q_new / q_tr = xv / w, the root's reciprocal
+            m_new = -p_new * inv_3K
             s_new = ti.exp(dev * scale + m_new)
             ljp_new = ljp + tr - 3.0 * m_new
         return s_new, ljp_new, hit
