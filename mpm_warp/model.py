@@ -96,16 +96,14 @@ def lattice_counts(lo, hi, dx: float, ppc: int) -> tuple[int, ...]:
 def material_params(material: Elastic, T):
     """Kernel-side parameters (``kernels.constitutive.material_struct``) of a material, scalar type ``T``."""
     m = material_struct(T)()
-    m.mu = T(material.mu)
-    m.lam = T(material.lam)
+    m.mu, m.lam = T(material.mu), T(material.lam)
     m.s_floor = T(SINGULAR_VALUE_FLOOR)
-    K = float(material.bulk)
-    m.K, m.inv_K = T(K), T(1.0 / K)
+    m.K, m.inv_K = T(material.bulk), T(1.0 / material.bulk)
     if isinstance(material, (CamClaySnow, BondedCamClay)):
         m.M, m.beta, m.xi, m.p0_floor = T(material.M), T(material.beta), T(material.xi), T(material.p0_floor)
         m.log_jp_ref = T(material.initial_log_jp)
-        m.ell_rho, m.ell_inv_rho, m.ell_c, m.ell_inv_c = (T(x) for x in ellipse_axes(K, material.mu, material.M,
-                                                                                       material.beta))
+        axes = ellipse_axes(material.bulk, material.mu, material.M, material.beta)
+        m.ell_rho, m.ell_inv_rho, m.ell_c, m.ell_inv_c = (T(x) for x in axes)
     if isinstance(material, BondedCamClay):
         m.p_bond, m.kappa_s = T(material.p_bond), T(material.kappa_s)
     if isinstance(material, CrackingSnow):
