@@ -75,6 +75,7 @@ def render_pst_scaling(data: dict, ctx) -> list[str]:
 def render_pst_flat_wall(data: dict, ctx) -> list[str]:
     s = data["summary"]
     work = s["n_particles"] * s["steps"]
+    block = 0.5 * (data["block_rate_before"] + data["block_rate_after"])
     out = table(["command", "wall time", "particles", "steps", "stepping (M particle-steps/s)",
                  "elastic block before / after (M/s)"],
                 [[f"`{data['command']}`", secs(data["wall_s"]), count(s["n_particles"]), count(s["steps"]),
@@ -82,9 +83,10 @@ def render_pst_flat_wall(data: dict, ctx) -> list[str]:
                   f"{fx(data['block_rate_before'], 2, M)} / {fx(data['block_rate_after'], 2, M)}"]])
     out += ["", env_note(data), "",
             f"- {fx(data['wall_s'] / 60, 1)} min, after a short run of the scene compiled its kernels; the command "
-            f"ran on {data['threads']} threads. Its {fx(work / 1e9, 1)} G particle-steps in 15 min would take "
-            f"{fx(work / 900, 1, M)} M particle-steps/s, {fx(work / 900 / s['particle_steps_per_s'], 2)}x the "
-            "rate it ran at.",
+            f"ran on {data['threads']} threads, {fx(s['particle_steps_per_s'] / block, 2)}x the elastic block's "
+            f"rate (mean of before and after). Its {fx(work / 1e9, 1)} G particle-steps in 15 min take "
+            f"{fx(work / 900, 1, M)} M particle-steps/s: at that ratio, any day on which the block runs at "
+            f"{fx(work / 900 / (s['particle_steps_per_s'] / block), 1, M)} M/s or more.",
             "- The elastic block (82,944 particles, 2 threads, 200 steps) was timed just before and just after the "
             "run: this shared machine's speed on the day, against which a run on another day can be scaled."]
     return out
