@@ -17,7 +17,7 @@ from .bonded_camclay import bonded_camclay_return_strain_func, bonded_p0_func
 from .camclay import camclay_p0_func, camclay_project_axes_func, camclay_return_strain_func, camclay_yield_func
 from .cracking import crack_func
 from .elasticity import hencky_strain_func
-from .logstrain import expm1_func, expm1_small_func, expm1_sym_func, log1p_func, log_strain_func
+from .logstrain import expm1_func, expm1_order, expm1_small_func, expm1_sym_func, log1p_func, log_strain_func
 from .principal import principal_strain_func
 from .types import mat, vec
 
@@ -219,6 +219,9 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
     expm1 = expm1_func(T)
     expm1_sym = expm1_sym_func(T, dim)
     expm1_small = expm1_small_func(T)
+    tiny = 1.0 / 256.0  # |D| up to which the exponential series takes fewer terms (expm1_order)
+    expm1_sym_tiny = expm1_sym_func(T, dim, expm1_order(T, tiny))
+    expm1_small_tiny = expm1_small_func(T, expm1_order(T, tiny))
     sqrt6 = _SQRT6
     third = 1.0 / 3.0  # a Python float: a multiply (a division by 3 stays a division without fast math)
 
@@ -274,12 +277,21 @@ def constitutive_update_func(dim, T, model, decomposition_free=True):
         Dzz = T(0.0)
         if wp.static(dim == 2):
             Dzz = (scale * (ezz - mean) + mean_new) - ezz
-        if wp.ddot(D, D) + Dzz * Dzz > T(0.0625):
+        d2 = wp.ddot(D, D) + Dzz * Dzz
+        if d2 > T(0.0625):
             return H_tr, hzz, M(), lj, kap, int(0), int(0)
-        H_new = H_tr + expm1_sym(D) * (I + H_tr)
+        E = M()
+        ezz_m1 = T(0.0)
+        if d2 <= T(wp.static(tiny * tiny)):  # a step's correction: a few terms of the series
+            E = expm1_sym_tiny(D)
+            ezz_m1 = expm1_small_tiny(Dzz)
+        else:
+            E = expm1_sym(D)
+            ezz_m1 = expm1_small(Dzz)
+        H_new = H_tr + E * (I + H_tr)
         hzz_new = hzz
         if wp.static(dim == 2):
-            hzz_new = hzz + (T(1.0) + hzz) * expm1_small(Dzz)
+            hzz_new = hzz + (T(1.0) + hzz) * ezz_m1
         return H_new, hzz_new, T(2.0) * m.mu * eps_new + (m.lam * tr_new) * I, lj_new, kap_new, YIELDED, int(1)
 
     @wp.func

@@ -29,6 +29,7 @@ exactly (:func:`log1p_func`).
 """
 
 import functools
+import math
 
 import warp as wp
 
@@ -140,21 +141,18 @@ def log1p_func(T):
     """Return ``log1p(h) = ln(1 + h)`` accurate for small ``h``; ``h > -1``.
 
     For ``|h| <= 1/16`` (every elastic strain of snow) by its series ``h - h^2/2 + h^3/3 - ...`` to ``h^n``
-    in Horner form, ``n = 7`` (float32) or 13 (float64): the first omitted term is below
+    by :func:`poly_func`, ``n = 7`` (float32) or 13 (float64): the first omitted term is below
     ``|h| 16^-n / (n + 1)`` (4.7e-10 and 1.6e-17 of ``|h|``, under the rounding unit), with no library
     ``log`` and no division. Beyond, Goldberg's ``ln(u) h / (u - 1)``, ``u = 1 + h`` (1991, Theorem 4).
     """
     order = 7 if T == wp.float32 else 13
-    coef = [(-1.0) ** (k + 1) / k for k in range(order, 1, -1)]  # (-1)^(k+1)/k, k = n..2 (Python floats)
+    series = poly_func(T, tuple((-1.0) ** (k + 1) / k for k in range(2, order + 1)))  # (-1)^(k+1)/k, k = 2..n
 
     @wp.func
     def log1p(h: T):
         r = h
         if wp.abs(h) <= T(0.0625):
-            e = T(wp.static(coef[0]))
-            for j in range(1, wp.static(order - 1)):  # unrolled: constant bounds
-                e = T(wp.static(coef[j])) + h * e
-            r = h + (h * h) * e
+            r = h + (h * h) * series(h)
         else:
             u = T(1.0) + h
             r = wp.log(u) * (h / (u - T(1.0)))
@@ -183,7 +181,7 @@ def expm1_func(T):
 
 
 @functools.cache
-def expm1_sym_func(T, dim=3):
+def expm1_sym_func(T, dim=3, order=None):
     """Return ``expm1_sym(D) -> exp(D) - I`` for a small symmetric ``dim x dim`` matrix ``D`` (``|D|_F <= 1/4``).
 
     The series ``sum_k D^k / k!`` from ``k = 1`` (no cancellation against ``I``, so a
@@ -191,10 +189,11 @@ def expm1_sym_func(T, dim=3):
     :func:`log_strain_func` (Cayley-Hamilton). With ``|D|_F <= 1/4`` the first omitted term is
     below ``|D| 4^-n / (n + 1)!``: ``n = 8`` (float32, 4e-11 of ``|D|``) and ``n = 13``
     (float64, 2e-19). The constitutive update applies it to the plastic correction
-    ``D = eps_new - eps`` of a return that kept the eigenvectors of the trial.
+    ``D = eps_new - eps`` of a return that kept the eigenvectors of the trial. ``order`` overrides ``n`` for a
+    caller that knows ``|D|`` smaller (:func:`expm1_order`).
     """
     M = mat(dim, T)
-    order = 8 if T == wp.float32 else 13
+    order = order or expm1_order(T)
 
     @wp.func
     def expm1_sym(D: M):
@@ -244,22 +243,57 @@ def expm1_sym_func(T, dim=3):
     return expm1_sym
 
 
+def expm1_order(T, d_max=0.25):
+    """The order ``n`` of the exponential series for ``|D| <= d_max`` (``d_max = 1/4`` or ``1/256``): the first
+    omitted term is below ``|D| d_max^n / (n + 1)!``, under a fifth of the rounding unit: ``n = 8`` (float32,
+    4e-11) and 13 (float64, 2e-19) for 1/4; ``n = 3`` (float32, 2.5e-9) and 6 (float64, 7e-19) for 1/256, the
+    plastic correction of one step of any but a violent flow (the struck block's are below 1/800).
+    """
+    if d_max == 0.25:
+        return 8 if T == wp.float32 else 13
+    if d_max == 1.0 / 256.0:
+        return 3 if T == wp.float32 else 6
+    raise ValueError(f"d_max = {d_max!r}: expected 0.25 or 1/256")
+
+
 @functools.cache
-def expm1_small_func(T):
-    """Return ``expm1_small(x) -> exp(x) - 1`` for ``|x| <= 1/4`` by the series of :func:`expm1_sym_func` (Horner).
+def expm1_small_func(T, order=None):
+    """Return ``expm1_small(x) -> exp(x) - 1`` for ``|x| <= 1/4`` by the series of :func:`expm1_sym_func`.
 
     The scalar companion of ``expm1_sym`` (the out-of-plane entry of the same correction in
-    plane strain), a tenth of the cost of ``exp`` and ``log`` in :func:`expm1_func`.
+    plane strain), a tenth of the cost of ``exp`` and ``log`` in :func:`expm1_func`: ``x p(x)``,
+    ``p(x) = sum_{k < n} x^k / (k + 1)!`` by :func:`poly_func`; ``order`` as in :func:`expm1_sym_func`.
     """
-    order = 8 if T == wp.float32 else 13
-    inv_k = [1.0 / k for k in range(order, 1, -1)]  # 1/n, ..., 1/2 (Python floats, rounded once to T)
+    order = order or expm1_order(T)
+    p = poly_func(T, tuple(1.0 / math.factorial(k + 1) for k in range(order)))
 
     @wp.func
     def expm1_small(x: T):
-        # x (1 + x/2 (1 + x/3 (... (1 + x/n))))
-        e = T(1.0)
-        for j in range(wp.static(order - 1)):  # unrolled: constant bounds
-            e = T(1.0) + (x * e) * T(wp.static(inv_k[j]))
-        return x * e
+        return x * p(x)
 
     return expm1_small
+
+
+@functools.cache
+def poly_func(T, coeffs):
+    """Return ``poly(x) -> sum_k coeffs[k] x^k`` (``coeffs``: a tuple of Python floats, rounded once to ``T``).
+
+    Horner's rule in ``x^2`` on the even and the odd coefficients, two independent chains of half the
+    length (``E(x^2) + x O(x^2)``): the series of this module are latency-bound in the constitutive
+    update, and this halves their dependency chain for the same operation count.
+    """
+    even = list(coeffs[0::2])[::-1]  # highest power first
+    odd = list(coeffs[1::2])[::-1] or [0.0]
+
+    @wp.func
+    def poly(x: T):
+        x2 = x * x
+        e = T(wp.static(even[0]))
+        for j in range(1, wp.static(len(even))):  # unrolled: constant bounds
+            e = T(wp.static(even[j])) + x2 * e
+        o = T(wp.static(odd[0]))
+        for j in range(1, wp.static(len(odd))):  # unrolled: constant bounds
+            o = T(wp.static(odd[j])) + x2 * o
+        return e + x * o
+
+    return poly

@@ -9,9 +9,10 @@ outside its range (``|X| > 0.1``, ``det F <= 0``), and ``log1p``/``expm1`` are
 accurate for tiny arguments, where ``log(1 + h)`` would lose every digit.
 Tiny strains (down to 1e-30, where the full series would compute in subnormal
 numbers) keep the same relative accuracy. ``expm1_sym`` (``exp(D) - I`` of a
-symmetric ``D``, ``|D| <= 1/4``) and ``expm1_small`` against ``eigh`` and
-``numpy.expm1`` in float64: within 32 rounding units of ``|D|`` (measured worst 20 u,
-float64 3D, where the recurrences and the reference's eigenvectors each lose a few).
+symmetric ``D``, ``|D| <= 1/4``, and with the shorter series of ``|D| <= 1/256``) and
+``expm1_small`` against ``eigh`` and ``numpy.expm1`` in float64: within 32 rounding units of
+``|D|`` (measured worst 20 u, float64 3D, where the recurrences and the reference's
+eigenvectors each lose a few).
 """
 
 
@@ -20,7 +21,14 @@ import pytest
 import warp as wp
 from helpers_validation import DEVICE
 
-from mpm_warp.kernels.logstrain import expm1_func, expm1_small_func, expm1_sym_func, log1p_func, log_strain_func
+from mpm_warp.kernels.logstrain import (
+    expm1_func,
+    expm1_order,
+    expm1_small_func,
+    expm1_sym_func,
+    log1p_func,
+    log_strain_func,
+)
 from mpm_warp.kernels.types import mat
 
 TOL = {"float32": 1e-6, "float64": 1e-14}
@@ -114,12 +122,14 @@ def test_series_keeps_tiny_strains(dim, precision):
     assert rel.max() < TOL[precision]
 
 
+@pytest.mark.parametrize("d_max", [0.25, 1.0 / 256.0])
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("precision", ["float32", "float64"])
-def test_expm1_of_a_small_symmetric_matrix(dim, precision):
+def test_expm1_of_a_small_symmetric_matrix(dim, precision, d_max):
     T, nt = TYPES[precision]
     M = mat(dim, T)
-    em_sym, em_small = expm1_sym_func(T, dim), expm1_small_func(T)
+    order = expm1_order(T, d_max)
+    em_sym, em_small = expm1_sym_func(T, dim, order), expm1_small_func(T, order)
 
     @wp.kernel(enable_backward=False, module="unique")
     def k(D: wp.array(dtype=M), x: wp.array(dtype=T), out: wp.array(dtype=M), xo: wp.array(dtype=T)):
@@ -131,9 +141,9 @@ def test_expm1_of_a_small_symmetric_matrix(dim, precision):
     n = 1000
     A = rng.normal(size=(n, dim, dim))
     S = A + np.transpose(A, (0, 2, 1))
-    S *= (np.geomspace(1e-9, 0.25, n) / np.sqrt((S * S).sum(axis=(1, 2))))[:, None, None]   # |D|_F up to 1/4
+    S *= (np.geomspace(1e-9, d_max, n) / np.sqrt((S * S).sum(axis=(1, 2))))[:, None, None]   # |D|_F up to d_max
     D = S.astype(nt)
-    x = (rng.choice([-1.0, 1.0], n) * np.geomspace(1e-12, 0.25, n)).astype(nt)
+    x = (rng.choice([-1.0, 1.0], n) * np.geomspace(1e-12, d_max, n)).astype(nt)
     out = wp.zeros(n, dtype=M, device=DEVICE)
     xo = wp.zeros(n, dtype=T, device=DEVICE)
     wp.launch(k, n, inputs=[wp.array(D, dtype=M, device=DEVICE), wp.array(x, dtype=T, device=DEVICE), out, xo],
@@ -142,6 +152,6 @@ def test_expm1_of_a_small_symmetric_matrix(dim, precision):
     ref = np.einsum("nij,nj,nkj->nik", Q, np.expm1(w), Q)
     u = 2.0**-24 if precision == "float32" else 2.0**-53
     err = np.abs(out.numpy() - ref).max(axis=(1, 2)) / np.abs(D.astype(np.float64)).max(axis=(1, 2))
-    print(f"{dim}D {precision}: expm1_sym worst error {err.max() / u:.1f} u of |D|")
+    print(f"{dim}D {precision} order {order}: expm1_sym worst error {err.max() / u:.1f} u of |D|")
     assert err.max() < 32 * u
     np.testing.assert_allclose(xo.numpy(), np.expm1(x.astype(np.float64)), rtol=4 * u)
