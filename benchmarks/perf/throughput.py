@@ -121,7 +121,7 @@ def figure(out: dict, path: str) -> None:
     dims = sorted({r["dim"] for r in rows}, reverse=True)
     if not dims:
         return
-    fig, axes = plt.subplots(1, len(dims), figsize=(5.5 * len(dims), 4.2), squeeze=False)
+    fig, axes = plt.subplots(1, len(dims), figsize=(5.5 * len(dims), 5.2), squeeze=False)
     for ax, dim in zip(axes[0], dims, strict=True):
         keys = sorted({(r["material"], r["engine"], r["threads"]) for r in rows if r["dim"] == dim},
                       key=lambda k: (k[0], k[2] or 0, k[1] != "mpm_warp"))
@@ -136,7 +136,7 @@ def figure(out: dict, path: str) -> None:
         ax.set(xlabel="particles", ylabel="particle-steps per second (wall clock, median)",
                title=f"{dim}D{' (plane strain)' if dim == 2 else ''}, {out['environment']['device']}")
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.15))  # below: no point hidden
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
