@@ -147,24 +147,30 @@ def cmd_run(a) -> int:
 
 
 def cmd_profile(a) -> int:
+    from .field import FieldCase, field_case
     from .scenes.profile import read_profile
 
     data = read_profile(a.file)
     print(data.summary())
-    if data.pst_tests:
-        from .scenes.pst.field_inversion import field_fracture_energy
-
-        for t in data.pst_tests:
-            r = field_fracture_energy(a.file, t)
-            if "G" not in r:
-                print(f"  {r['note']}")
-                continue
-            p = r["params"]
-            print(f"  weac: G = {r['G']:.3g} J/m^2 (G_I {r['G_I']:.2g}, G_II {r['G_II']:.2g}) at the cut of "
-                  f"{t.cut_length * 100:.0f} cm: the weak layer's fracture energy this test implies (weak layer "
-                  f"E {p.weak_layer.E / 1e6:g} MPa, nu {p.weak_layer.nu:g}, cut from {p.saw.cut_from}, "
-                  f"{p.column_ends.replace('_', '-')} ends)")
+    for rec in data.pst_tests:
+        case = field_case(data, rec, calibrate=not a.no_calibration)
+        print(f"  {case.test}: " + (_case_line(case) if isinstance(case, FieldCase) else f"not set up: {case.message}"))
     return 0
+
+
+def _case_line(case) -> str:
+    """A set-up field case in one line, with its notes below it."""
+    wf, p = case.fracture_energy, case.params
+    if wf.value is not None:
+        w = (f"the weak layer's fracture energy this test implies: {wf.value:.3g} J/m^2 (weac's G at the cut; G_I "
+             f"{wf.G_I:.2g}, G_II {wf.G_II:.2g}; weak layer E {p.weak_layer.E / 1e6:g} MPa, nu {p.weak_layer.nu:g}, "
+             f"cut from {p.saw.cut_from}, {p.column_ends.replace('_', '-')} ends)")
+    else:
+        w = f"no fracture energy read back ({wf.reason}); runs with the default {p.weak_layer.w_f:g} J/m^2"
+    from .scenes.profile.column import describe
+
+    notes = "".join(f"\n      note: {n}" for n in case.notes)
+    return f"{describe(case.column)}; {w}{notes}"
 
 
 def cmd_resume(a) -> int:
@@ -343,6 +349,9 @@ def build_parser() -> argparse.ArgumentParser:
     pl.set_defaults(func=cmd_plot)
     pr = sub.add_parser("profile", help="read a CAAML snow profile: its layers, densities and PST results")
     pr.add_argument("file", help="a CAAML 5 or 6 XML snow profile")
+    pr.add_argument("--no-calibration", action="store_true",
+                    help="set up each PST's column without calibrating its weak layer (faster; a column the "
+                         "calibration would refuse is then not found)")
     pr.set_defaults(func=cmd_profile)
     _add_sweep(sub)
     return p

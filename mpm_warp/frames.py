@@ -39,7 +39,7 @@ def open_writer(sim, path: str) -> io.RunWriter:
     for m in sim.monitors.values():
         for name, (shape, unit) in getattr(m, "particle_fields", dict)().items():
             pf[name] = (shape, sc.precision, unit)
-    group_id = np.zeros(model.n_particles, dtype=np.uint8)
+    group_id = np.zeros(model.n_particles, dtype=np.min_scalar_type(max(len(model.groups) - 1, 0)))
     for i, g in enumerate(model.groups):
         group_id[g.start:g.end] = i
     static = {"x0": (sim.x0.astype(model.np_dtype), "m"), "group": (group_id, "1")}

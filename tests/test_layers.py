@@ -1,9 +1,9 @@
 """The package imports only downward (docs/architecture.md): no cycle, no upward import, every package installed.
 
 Layers, bottom to top: kernels -> engine -> validation (reference problems) -> scenes -> loader and runner
--> post-processing -> studies (what the benchmarks share) -> CLI and sweeps -> the package facade
-``mpm_warp/__init__.py``. Every ``import`` in
-every module counts, also those inside functions (a late import is still a dependency).
+-> post-processing -> field data (real pits as scenes) -> studies (what the benchmarks share) -> CLI and sweeps
+-> the package facade ``mpm_warp/__init__.py``. Every ``import`` in every module counts, also those inside
+functions (a late import is still a dependency).
 """
 
 from __future__ import annotations
@@ -19,7 +19,8 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PACKAGES = {"mpm_warp": "mpm_warp", "mpm_warp.kernels": "kernels"}
-LAYERS = ["kernels", "engine", "validation", "scenes", "scene API", "post", "studies", "CLI and sweeps", "facade"]
+LAYERS = ["kernels", "engine", "validation", "scenes", "scene API", "post", "field", "studies", "CLI and sweeps",
+          "facade"]
 
 
 def layer(module: str) -> int:
@@ -38,6 +39,8 @@ def layer(module: str) -> int:
         return LAYERS.index("scene API")
     if top == "post":
         return LAYERS.index("post")
+    if top == "field":
+        return LAYERS.index("field")
     if top == "studies":
         return LAYERS.index("studies")
     if top in ("cli", "sweep", "sweep_summary"):

@@ -30,10 +30,11 @@ def test_the_example_reads_back_with_its_densities_site_and_pst():
         ("PP", None, "F"), ("RGwp", "DF", "1F"), ("SH", None, "F"), ("RG", "FC", "P"), ("FCxr", "RG", "1F+"),
         ("DH", "FC", "4F")]
     rho = [L.density for L in p.layers]
-    # PP, F: 45 + 36; two 3 cm samples 215 and 245 in layer 1; SH: no law; one sample 300;
+    # PP, F: 45 + 36; two 3 cm samples 215 and 245 in layer 1; SH: no law, weac's grain-type 125; one sample 300;
     # FCxr (class FCmx), 1F+: 56 + 64 (3 + 1/3); DH, 4F: 185 + 25 * 2
     assert rho[0] == pytest.approx(81.0, abs=1e-9) and rho[1] == pytest.approx(230.0, abs=1e-9)
-    assert rho[2] is None and rho[3] == pytest.approx(300.0, abs=1e-9)
+    assert rho[2] == 125.0 and p.layers[2].density_source.startswith("fallback: grain-type value for SH")
+    assert rho[3] == pytest.approx(300.0, abs=1e-9)
     assert rho[4] == pytest.approx(56 + 64 * 10 / 3, abs=1e-9) and rho[5] == pytest.approx(235.0, abs=1e-9)
     assert p.layers[0].density_source == "Geldsetzer and Jamieson 2000 from hardness F and grain PP"
     assert p.layers[4].density_source == "Geldsetzer and Jamieson 2000 from hardness 1F+ and grain FCxr (class FCmx)"
@@ -93,13 +94,14 @@ def test_a_weak_layer_out_of_range_is_refused_in_one_line(kw, text):
     assert text in str(e.value) and "\n" not in str(e.value) and isinstance(e.value, InvalidArgument)
 
 
-def test_a_slab_layer_without_density_is_refused_naming_it():
-    p = read_profile(example_path())
+def test_a_slab_layer_without_density_is_refused_naming_it(tmp_path):
+    path = write(tmp_path, "bare.caaml", [(0.0, 0.3, "RG", None, "1F"), (0.3, 0.2, None, None, None),
+                                          (0.5, 0.3, "FC", None, "F")])
     with pytest.raises(ProfileError) as e:
-        select_weak_layer(p, index=3)           # the surface hoar would be in the slab
+        select_weak_layer(read_profile(path), index=2)           # the bare layer would be in the slab
     msg = str(e.value)
-    assert "layer 2 (depth 0.48-0.5 m) density = None is invalid: expected a density for a slab layer" in msg
-    assert "grain SH has no Geldsetzer and Jamieson 2000 law" in msg and "\n" not in msg
+    assert "layer 1 (depth 0.3-0.5 m) density = None is invalid: expected a density for a slab layer" in msg
+    assert "neither a hand hardness nor a grain form recorded" in msg and "\n" not in msg
 
 
 def test_a_layer_takes_the_overlap_weighted_density_of_the_samples(tmp_path):
@@ -130,7 +132,9 @@ def test_the_secondary_grain_and_extrapolation_are_named_in_the_source(tmp_path)
     assert L[1].density == pytest.approx(112 + 46 * 1)
     assert L[1].density_source == ("Geldsetzer and Jamieson 2000 from hardness F and grain FC, the secondary grain: "
                                    "SH has no law")
-    assert L[2].density is None and "MFcr has no Geldsetzer and Jamieson 2000 law" in L[2].density_source
+    # a melt-freeze crust has no hardness law: weac's grain-type value, flagged as a fallback
+    assert L[2].density == 292.25
+    assert L[2].density_source == "fallback: grain-type value for MFcr (weac's table: no hardness law for this grain)"
 
 
 #: a minimal CAAML 5 profile written by hand (CAAMLv5_SnowProfileIACS.xsd: depths top down, in cm)

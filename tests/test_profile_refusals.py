@@ -26,12 +26,6 @@ def refused(path) -> str:
 
 
 @pytest.mark.parametrize("layers, text", [
-    ([(0.0, 0.3, "RG", None, "1F"), (0.3, 0.3, "RG", None, None)],
-     "layer 1 (depth 0.3-0.6 m) density = None is invalid: expected a measured density, or a hand hardness and a "
-     "grain form for the hardness law (hardness = None, grain = 'RG')"),
-    ([(0.0, 0.3, "RG", None, "1F"), (0.3, 0.3, None, None, "P")],
-     "layer 1 (depth 0.3-0.6 m) density = None is invalid: expected a measured density, or a hand hardness and a "
-     "grain form for the hardness law (hardness = 'P', grain = None)"),
     ([(0.0, 0.3, "RG", None, "1F"), (0.3, 0.0, "SH", None, "F"), (0.3, 0.3, "RG", None, "P")],
      "layer 1 (depth 0.3-0.3 m) thickness = 0.0 is invalid: expected a layer thickness > 0 m"),
     ([(0.0, 0.3, "RG", None, "1F"), (0.3, -0.05, "SH", None, "F"), (0.3, 0.3, "RG", None, "P")],

@@ -29,7 +29,9 @@ def test_the_example_profile_gives_the_pst_its_snowpack():
     assert p.weak_layer.density == 150.0                 # buried surface hoar: not measured, from the file
     (sub,) = p.substratum_stack()
     assert sub.thickness == pytest.approx(0.15) and sub.density == pytest.approx(300.0)
-    assert len(p.profile.sha256) == 64 and p.profile.weak_layer.startswith("layer 2 (depth 0.48-0.5 m): SH")
+    assert len(p.profile.sha256) == 64
+    assert p.profile.weak_layer.startswith("slab 48 cm (2 layers), weak layer 2 cm (the profile layer's own (SH, 2 cm))")
+    assert p.profile.weak_layer.endswith("in layer 2 (depth 0.48-0.5 m): SH F")
     # the layers load the weak layer: sum rho g h cos(slope)
     assert p.sigma_n == pytest.approx(9.81 * COS35 * COS35 * (81.0 * 0.10 + 230.0 * 0.38), rel=1e-9)
     assert [b.name for b in sc.blocks] == ["substratum", "weak_layer", "slab_2", "slab_1"]
@@ -51,9 +53,10 @@ def _raw(**profile):
 
 
 @pytest.mark.parametrize("profile, extra, needle", [
-    ({"weak_layer_depth": 1.5}, {}, "weak layer depth = 1.5 is invalid: expected a depth in [0.1, 1.2) m"),
+    ({"weak_layer_depth": 1.5}, {}, "scene.profile.weak_layer_depth = 1.5 is invalid: expected a depth in (0, 1.2) m"),
     ({"weak_layer_index": 9}, {}, "weak layer index = 9 is invalid: expected an integer in [1, 5]"),
-    ({"weak_layer_index": 1}, {}, "layer 2 (depth 0.48-0.5 m) density"),    # the SH layer in the slab
+    ({"weak_layer_thickness": 0.9}, {}, "scene.profile.weak_layer_thickness = 0.9 is invalid: expected a number in "
+                                        "[0, 0.5]"),
     ({"weak_layer_depth": 0.49}, {"slab_thickness": 0.4}, "scene.slab_thickness = 0.4 is invalid: expected left out"),
     ({"weak_layer_depth": 0.49, "thickness": "sideways"}, {}, "scene.profile.thickness"),
     ({"weak_layer_depth": 0.49, "layers": 3}, {}, "scene.profile.layers = 3 is invalid"),
@@ -96,16 +99,17 @@ def test_from_python_a_profile_is_a_scene_table():
 def test_a_field_pst_read_backwards_gives_the_fracture_energy_that_reproduces_its_cut(capsys):
     """The profile's PST 32/100: weac's G at 32 cm is the fracture energy, and weac's critical cut with that
     G_c is 32 cm again (the round trip closes to the root finder's tolerance); the CLI prints it."""
+    from mpm_warp.field import field_case
     from mpm_warp.scenes.profile import read_profile
-    from mpm_warp.scenes.pst.field_inversion import field_fracture_energy
     from mpm_warp.scenes.pst.static import static_column
     from mpm_warp.scenes.weac_reference import critical_cut_search
 
-    (rec,) = read_profile(example_path()).pst_tests
-    r = field_fracture_energy(example_path(), rec)
-    assert r["cut"] == 0.32 and r["params"].length == 1.0 and r["params"].slope_angle == 35.0
-    assert r["G"] == pytest.approx(r["G_I"] + r["G_II"], rel=1e-12)
-    assert 0.05 < r["G"] < 0.15  # measured 0.0778 J/m^2 (weak layer E 1 MPa, a stiff wind slab above)
-    assert critical_cut_search(static_column(r["params"]), r["G"]).value == pytest.approx(0.32, abs=1e-9)
+    prof = read_profile(example_path())
+    case = field_case(prof, prof.pst_tests[0], calibrate=False)
+    wf, p = case.fracture_energy, case.params
+    assert p.saw.cut_length == 0.32 and p.length == 1.0 and p.slope_angle == 35.0
+    assert wf.G == pytest.approx(wf.G_I + wf.G_II, rel=1e-12) and wf.value == wf.G
+    assert wf.G == pytest.approx(0.0778, abs=5e-4)  # the surface hoar (2 cm, E 1 MPa) under a stiff wind slab
+    assert critical_cut_search(static_column(p), wf.G).value == pytest.approx(0.32, abs=1e-9)
     assert main(["profile", example_path()]) == 0
-    assert f"weac: G = {r['G']:.3g} J/m^2" in capsys.readouterr().out
+    assert f"the weak layer's fracture energy this test implies: {wf.G:.3g} J/m^2" in capsys.readouterr().out

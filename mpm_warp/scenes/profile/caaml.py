@@ -1,11 +1,10 @@
 """Reading a CAAML snow profile (as SnowPilot, niViz and other field apps export it) into plain records.
 
-The file is parsed by the ``snowprofile`` library (UMR-CNRM, the optional extra ``profile``:
-``pip install 'mpm-warp[profile]'``): CAAML 6 XML (6.0.3 to 6.0.5) and CAAML 5 XML. Then every
-layer is checked and gets its density: from the profile's density profile where a sample overlaps
-it, otherwise from its hand hardness and grain form (:mod:`..density_laws`). What is refused, and why
-gaps are not filled, is in docs/profiles.md; every refusal is one :class:`ProfileError` line naming
-the file, the layer (index from the top and depth) and the value.
+A SnowPilot export (CAAML 6.0.3) is parsed by ``snowpylot`` (:mod:`.snowpilot`), any other CAAML 6 XML
+(6.0.3 to 6.0.5) or CAAML 5 XML by ``snowprofile`` (UMR-CNRM); both are in the optional extra ``profile``
+(``pip install 'mpm-warp[profile]'``). Then the layers are checked and get their densities
+(:mod:`.stratigraphy`). What is refused, and why gaps are not filled, is in docs/profiles.md; every refusal
+is one :class:`ProfileError` line naming the file, the layer (index from the top and depth) and the value.
 """
 
 from __future__ import annotations
@@ -17,16 +16,13 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..density_laws import GJ_FITS, GRAIN_CLASS, HARDNESS_INDEX, geldsetzer_jamieson_density
 from .diagnose import diagnose_layers
-from .records import MEASURED, ProfileError, ProfileLayer, ProfileLibraryMissing, PSTRecord, SnowProfileData, metres
+from .records import ProfileError, ProfileLayer, ProfileLibraryMissing, PSTRecord, SnowProfileData
+from .snowpilot import is_snowpilot, read_snowpilot
 from .source import caaml_version, read_capped
+from .stratigraphy import TOLERANCE, build_layers, check_samples
 
 __all__ = ["read_profile", "TOLERANCE", "import_snowprofile"]
-
-#: largest mismatch between consecutive layers taken as rounding (m): field profiles are recorded to
-#: 0.5-1 cm, so half a millimetre is never snow; a larger gap or overlap is refused
-TOLERANCE = 5.0e-4
 
 INSTALL = "pip install 'mpm-warp[profile]' (or: pip install snowprofile 'pandas<3')"
 
@@ -125,71 +121,8 @@ def _samples(sp, path: str) -> np.ndarray:
         return np.zeros((0, 3))
     prof = sp.density_profiles[0]
     df, h0 = prof.data, _depth_origin(prof, sp)
-    rows = []
     columns = (_column(df, "top_height"), _column(df, "thickness"), _column(df, "density"))
-    for k, (top, th, rho) in enumerate(zip(*columns, strict=True)):
-        d_top = round(h0 - float(top), 6)
-        where = f"{path}: density-profile sample {k} (depth {metres(d_top)} m)"
-        th = float("nan") if th is None else float(th)
-        if not th > 0.0:
-            raise ProfileError(f"{where} thickness", th, "a sample thickness > 0 m")
-        if rho is None or not (math.isfinite(float(rho)) and 0.0 < float(rho) <= 917.0):
-            raise ProfileError(f"{where} density", rho, "a density in (0, 917] kg/m^3")
-        rows.append((d_top, round(d_top + th, 6), float(rho)))
-    return np.array(rows, dtype=float).reshape(-1, 3)
-
-
-def _overlap_means(tops: np.ndarray, bottoms: np.ndarray, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per layer: the length covered by samples and the overlap-weighted mean sample density (nan: none).
-
-    Covered length and mass above depth z are sums of ramps, piecewise linear between the samples'
-    ends: built once by a sweep, read at the layer boundaries by interpolation (O((n + m) log m)).
-    """
-    if len(samples) == 0:
-        return np.zeros(len(tops)), np.full(len(tops), np.nan)
-    st, sb, rho = samples.T
-    z = np.concatenate([st, sb])
-    order = np.argsort(z, kind="stable")
-    z = z[order]
-    slope_c = np.cumsum(np.concatenate([np.ones_like(st), -np.ones_like(sb)])[order])
-    slope_m = np.cumsum(np.concatenate([rho, -rho])[order])
-    dz = np.diff(z)
-    C = np.concatenate([[0.0], np.cumsum(slope_c[:-1] * dz)])
-    M = np.concatenate([[0.0], np.cumsum(slope_m[:-1] * dz)])
-    covered = np.interp(bottoms, z, C) - np.interp(tops, z, C)
-    mass = np.interp(bottoms, z, M) - np.interp(tops, z, M)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.where(covered > TOLERANCE, mass / np.where(covered > 0, covered, 1.0), np.nan)
-    return covered, mean
-
-
-def _law(hardness: str | None, g1: str | None, g2: str | None, where: str) -> tuple[float | None, str]:
-    """Density and its source from hand hardness and grain form (None: the grain has no law)."""
-    if hardness is None or g1 is None:
-        raise ProfileError(f"{where} density", None, "a measured density, or a hand hardness and a grain form "
-                                                     f"for the hardness law (hardness = {hardness!r}, "
-                                                     f"grain = {g1!r})")
-    if hardness not in HARDNESS_INDEX:
-        raise ProfileError(f"{where} hardness", hardness, "a hand hardness: F, 4F, 1F, P, K, I, e.g. '4F-1F', '1F+'")
-    for name, grain in (("grain_1", g1), ("grain_2", g2)):
-        if grain is not None and grain not in GRAIN_CLASS:
-            raise ProfileError(f"{where} {name}", grain, "an IACS grain shape code, e.g. 'RG', 'FCxr', 'SH'")
-    for grain in (g1, g2):
-        cls = None if grain is None else GRAIN_CLASS[grain]
-        if cls is None:
-            continue
-        fit = GJ_FITS[cls]
-        src = f"Geldsetzer and Jamieson 2000 from hardness {hardness} and grain {grain}"
-        if cls != grain:
-            src += f" (class {cls})"
-        if grain != g1:
-            src += f", the secondary grain: {g1} has no law"
-        lo, hi = (HARDNESS_INDEX[s] for s in fit.hardness_span)
-        if not lo <= HARDNESS_INDEX[hardness] <= hi:
-            src += f", extrapolated beyond the fit's hardness {fit.hardness_span[0]} to {fit.hardness_span[1]}"
-        return geldsetzer_jamieson_density(hardness, grain), src
-    grains = "/".join(g for g in (g1, g2) if g)
-    return None, f"none: grain {grains} has no Geldsetzer and Jamieson 2000 law and no density was measured"
+    return check_samples([(h0 - float(top), th, rho) for top, th, rho in zip(*columns, strict=True)], path)
 
 
 def _layers(sp, path: str) -> tuple[ProfileLayer, ...]:
@@ -197,37 +130,10 @@ def _layers(sp, path: str) -> tuple[ProfileLayer, ...]:
     if strat is None or strat.data is None or len(strat.data) == 0:
         raise ProfileError("profile", path, "a CAAML profile with a stratigraphy (it has no stratigraphy layers)")
     df, h0 = strat.data, _depth_origin(strat, sp)
-    tops = np.round(h0 - np.array(_column(df, "top_height"), dtype=float), 6)
-    ths = np.array([np.nan if t is None else float(t) for t in _column(df, "thickness")], dtype=float)
+    tops = h0 - np.array(_column(df, "top_height"), dtype=float)
+    ths = [np.nan if t is None else float(t) for t in _column(df, "thickness")]
     hard, g1s, g2s = (list(map(_text, _column(df, k))) for k in ("hardness", "grain_1", "grain_2"))
-    for i, (top, th) in enumerate(zip(tops, ths, strict=True)):
-        where = f"{path}: layer {i} (depth {metres(top)}-{metres(top + th)} m)"
-        if not th > 0.0:
-            raise ProfileError(f"{where} thickness", float(th), "a layer thickness > 0 m")
-        expected = 0.0 if i == 0 else tops[i - 1] + ths[i - 1]
-        if abs(top - expected) > TOLERANCE:
-            if i == 0:
-                raise ProfileError(f"{where} depth_top", float(top), "0 m: the first layer starts at the snow surface")
-            kind = "a gap" if top > expected else "an overlap"
-            raise ProfileError(f"{where} depth_top", float(top), f"{metres(expected)} m, the bottom of layer {i - 1} "
-                               f"({kind} of {metres(abs(top - expected))} m: layers must be contiguous; a gap is not "
-                               "filled, its snow was not described)")
-    hs = sp.profile_depth
-    if hs is not None and hs > 0 and tops[-1] + ths[-1] > hs + TOLERANCE:
-        i = len(tops) - 1
-        raise ProfileError(f"{path}: layer {i} (depth {metres(tops[i])}-{metres(tops[i] + ths[i])} m) depth_bottom",
-                           float(tops[i] + ths[i]), f"at most the snow depth HS = {metres(hs)} m")
-    covered, measured = _overlap_means(tops, tops + ths, _samples(sp, path))
-    out = []
-    for i in range(len(tops)):
-        where = f"{path}: layer {i} (depth {metres(tops[i])}-{metres(tops[i] + ths[i])} m)"
-        if np.isfinite(measured[i]):
-            rho, src = float(measured[i]), MEASURED
-        else:
-            rho, src = _law(hard[i], g1s[i], g2s[i], where)
-        out.append(ProfileLayer(index=i, depth_top=float(tops[i]), thickness=float(round(ths[i], 6)), density=rho,
-                                density_source=src, hardness=hard[i], grain_1=g1s[i], grain_2=g2s[i]))
-    return tuple(out)
+    return build_layers(tops, ths, hard, g1s, g2s, _samples(sp, path), sp.profile_depth, path)
 
 
 def _psts(sp) -> tuple[PSTRecord, ...]:
@@ -238,8 +144,9 @@ def _psts(sp) -> tuple[PSTRecord, ...]:
         depth = None
         if t.height is not None and sp.profile_depth is not None:
             depth = round(float(sp.profile_depth) - float(t.height), 6)
-        out.append(PSTRecord(cut_length=float(t.cut_length), column_length=None if t.column_length is None
-                             else float(t.column_length), propagation=t.propagation, depth=depth,
+        out.append(PSTRecord(cut_length=None if t.cut_length is None else float(t.cut_length),
+                             column_length=None if t.column_length is None else float(t.column_length),
+                             propagation=t.propagation, depth=depth,
                              layer_thickness=None if t.layer_thickness is None else float(t.layer_thickness),
                              grain_1=t.grain_1))
     return tuple(out)
@@ -259,19 +166,26 @@ def read_profile(path) -> SnowProfileData:
         The layers top to bottom (depths and thicknesses in m, densities in kg/m^3 with their source),
         the site (slope angle and aspect in deg, location name, date), HS (m) and the PST results.
 
+    Notes
+    -----
+    A SnowPilot export (CAAML 6.0.3) is read by snowpylot (:mod:`.snowpilot`), every other CAAML 5 or 6
+    file by snowprofile. A layer without a density (no hardness, no grain, a grain without a law) is kept
+    with the reason as its density source: it refuses a PST only where the model needs it (:mod:`.column`).
+
     Raises
     ------
     ProfileError
         One line naming the file and, for a bad layer, the layer (index from the top, depth) and the value:
         no such file, not a regular file, too large, not XML, not CAAML, a layer of zero or negative
-        thickness, a gap or overlap between layers, a layer with neither a measured density nor a hand
-        hardness and a grain form.
+        thickness, a gap or overlap between layers.
     ProfileLibraryMissing
-        snowprofile is not installed (the line says how to install it).
+        The library that reads this file is not installed (the line says how to install it).
     """
     data = read_capped(path)
     path = str(path)
     version = caaml_version(data, path)
+    if version == "6" and is_snowpilot(data):
+        return read_snowpilot(data, path)
     sp = _parse(data, version, path)
     layers = _layers(sp, path)
     loc = sp.location

@@ -18,7 +18,16 @@ MEASURED = "measured"
 
 
 class ProfileError(InvalidArgument):
-    """A snow profile that cannot be used: the message names the file, the layer (index and depth) and the value."""
+    """A snow profile that cannot be used: the message names the file, the layer (index and depth) and the value.
+
+    ``message``, when given, is the whole line instead of ``field = value is invalid: expected allowed`` (a refusal
+    in field terms: "the slab layer at 10-25 cm (RG 1F) has a measured density of 20 kg/m^3, ...").
+    """
+
+    def __init__(self, field: str, value, allowed: str, message: str | None = None):
+        super().__init__(field, value, allowed)
+        if message is not None:
+            self.args = (message,)
 
 
 class ProfileLibraryMissing(MPMError, ImportError):
@@ -86,12 +95,13 @@ class PSTRecord:
 
     Attributes
     ----------
-    cut_length : float
+    cut_length : float or None
         Critical cut length (m): the cut at which the crack propagated on its own.
     column_length : float or None
         Column length (m).
-    propagation : {"End", "SF", "Arr"}
-        The crack reached the end of the column, the slab fractured, or the crack arrested.
+    propagation : str or None
+        "End", "SF" or "Arr" (the crack reached the end of the column, the slab fractured, the crack
+        arrested), as recorded; "X" or None where the observer recorded no outcome.
     depth : float or None
         Depth of the top of the failed layer below the surface (m).
     layer_thickness : float or None
@@ -100,9 +110,9 @@ class PSTRecord:
         Primary grain shape of the failed layer.
     """
 
-    cut_length: float
+    cut_length: float | None
     column_length: float | None
-    propagation: Literal["End", "SF", "Arr"]
+    propagation: str | None
     depth: float | None
     layer_thickness: float | None
     grain_1: str | None
@@ -110,7 +120,8 @@ class PSTRecord:
     def field_line(self) -> str:
         """The line an observer writes: ``"PST 32/100 (End) down 48 cm"`` (lengths in cm)."""
         column = "?" if self.column_length is None else f"{self.column_length * 100:.0f}"
-        line = f"PST {self.cut_length * 100:.0f}/{column} ({self.propagation})"
+        cut = "?" if self.cut_length is None else f"{self.cut_length * 100:.0f}"
+        line = f"PST {cut}/{column} ({self.propagation or '?'})"
         return line if self.depth is None else f"{line} down {self.depth * 100:.0f} cm"
 
 
@@ -139,6 +150,8 @@ class SnowProfileData:
         The file it was read from.
     caaml_version : {"5", "6"}
         The CAAML major version of the file.
+    country : str or None
+        The country code as recorded (not checked: SnowPilot writes codes outside ISO 3166, e.g. "UT").
     """
 
     layers: tuple[ProfileLayer, ...]
@@ -150,6 +163,7 @@ class SnowProfileData:
     pst_tests: tuple[PSTRecord, ...]
     source: str
     caaml_version: Literal["5", "6"]
+    country: str | None = None
 
     @property
     def depth_described(self) -> float:

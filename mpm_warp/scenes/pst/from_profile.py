@@ -22,7 +22,10 @@ from typing import Literal
 from ...checks import check_choices, finite_number, positive_int
 from ...errors import InvalidArgument
 
-__all__ = ["ProfileSource", "expand_profile", "profile_table"]
+__all__ = ["ProfileSource", "expand_profile", "profile_table", "follow_grid", "CELLS_ACROSS"]
+
+#: grid cells across the weak layer when the scene file gives no dx (the resolution the snow ladders call resolved)
+CELLS_ACROSS = 4
 
 
 @dataclass(frozen=True)
@@ -37,7 +40,10 @@ class ProfileSource:
         The weak layer by its depth below the surface (m, as the profile records it); 0 = not given.
     weak_layer_index : int
         The weak layer by its index in the profile, from 1 (the layer under the surface layer); 0 = not
-        given. Neither given: the depth of the profile's first PST result.
+        given: the slab ends at its top. Neither given: the depth of the profile's first PST result.
+    weak_layer_thickness : float
+        The weak layer's thickness (m, as the profile records lengths), >= 0; 0 = by the rules of
+        :mod:`mpm_warp.scenes.profile.column` (the profile layer's when it is thin, else 3 cm).
     substratum_depth : float
         How much of the profile below the weak layer to model (m, bed-normal), >= 0; 0 = the scene's
         ``substratum_thickness``.
@@ -53,6 +59,7 @@ class ProfileSource:
     file: str = ""
     weak_layer_depth: float = 0.0
     weak_layer_index: int = 0
+    weak_layer_thickness: float = 0.0
     substratum_depth: float = 0.0
     thickness: Literal["vertical", "slope_normal"] = "vertical"
     sha256: str = ""
@@ -64,6 +71,7 @@ class ProfileSource:
             raise InvalidArgument(f"{where}.file", self.file, "a path to a CAAML file, or '' for none")
         finite_number(f"{where}.weak_layer_depth", self.weak_layer_depth, lo=0.0)
         positive_int(f"{where}.weak_layer_index", self.weak_layer_index, lo=0)
+        finite_number(f"{where}.weak_layer_thickness", self.weak_layer_thickness, lo=0.0, hi=0.5)
         finite_number(f"{where}.substratum_depth", self.substratum_depth, lo=0.0)
         check_choices(self, where)
         return self
@@ -89,9 +97,15 @@ def expand_profile(table: dict, base_dir: str = ".") -> dict:
         :func:`~mpm_warp.scenes.profile.select_weak_layer` refuse, in one line naming the layer.
     """
     prof = profile_table(table)
+    if "file" in prof and isinstance(prof["file"], str) and not prof["file"].strip():
+        defaults = {f.name: f.default for f in dataclasses.fields(ProfileSource)}
+        if any(prof.get(k, v) != v for k, v in defaults.items() if k != "file"):
+            raise InvalidArgument("scene.profile.file", prof["file"], "a path to a CAAML file (an empty path reads no "
+                                  "profile; leave [scene.profile] out to run without one)")
     if not prof.get("file"):
         return table
     from ..profile import read_profile, select_weak_layer
+    from ..profile.column import describe, profile_column
 
     keys = [f.name for f in dataclasses.fields(ProfileSource)]
     unknown = sorted(set(prof) - set(keys))
@@ -106,40 +120,51 @@ def expand_profile(table: dict, base_dir: str = ".") -> dict:
                                   "profile gives the slab, the weak layer's thickness and the layers below)")
     path = src.file if os.path.isabs(src.file) else os.path.join(base_dir, src.file)
     data = read_profile(path)
-    depth, index = src.weak_layer_depth or None, src.weak_layer_index or None
-    if depth is None and index is None:
+    depth = src.weak_layer_depth or None
+    if src.weak_layer_index:
+        _, weak, _ = select_weak_layer(data, index=src.weak_layer_index)
+        depth = weak.depth_top
+    if depth is None:
         rec = next((t for t in data.pst_tests if t.depth is not None), None)
         if rec is None:
             raise InvalidArgument("scene.profile.weak_layer_depth", 0.0, (
                 "the weak layer's depth (m) or scene.profile.weak_layer_index: the profile records no PST depth"))
         depth = rec.depth
-    slab, weak, below = select_weak_layer(data, depth=depth, index=index)
+    bottom = data.layers[-1].depth_bottom
+    if not 0.0 < depth < bottom:
+        raise InvalidArgument("scene.profile.weak_layer_depth", depth, f"a depth in (0, {bottom:.4g}) m below the "
+                              "surface: inside the described layers, with a slab above it")
     out = copy.deepcopy(table)
     slope = float(out.get("slope_angle", data.slope_angle if data.slope_angle is not None else 0.0))
     out["slope_angle"] = slope
     scale = math.cos(math.radians(slope)) if src.thickness == "vertical" else 1.0
-    out["slab_layers"] = [_layer(ly, scale) for ly in slab]
-    out["weak_layer_thickness"] = weak.thickness * scale
+    keep = float(src.substratum_depth or out.get("substratum_thickness", 0.15))
+    col = profile_column(data, depth, src.weak_layer_thickness or None, keep / scale)
+    out["slab_layers"] = [_layer(p, scale) for p in col.slab]
+    out["weak_layer_thickness"] = col.weak_layer_thickness * scale
+    weak = col.weak_layer
     if weak.density is not None and "density" not in (out.get("weak_layer") or {}):
         out.setdefault("weak_layer", {})["density"] = float(weak.density)
-    keep = float(src.substratum_depth or out.get("substratum_thickness", 0.15))
-    sub, total = [], 0.0
-    for ly in below:
-        if total >= keep - 1e-12:
-            break
-        h = min(ly.thickness * scale, keep - total)
-        sub.append({**_layer(ly, scale), "thickness": h})
-        total += h
-    if sub:
-        out["substratum_layers"] = sub
+    if col.substratum:
+        out["substratum_layers"] = [_layer(p, scale) for p in col.substratum]
         out.pop("substratum_thickness", None)
     rec = next((t for t in data.pst_tests if t.column_length), None)
     if "length" not in out and rec is not None:
         out["length"] = float(rec.column_length)
+    follow_grid(out)
     with open(path, "rb") as fh:
         digest = hashlib.sha256(fh.read()).hexdigest()
-    out["profile"] = {**prof, "sha256": digest, "weak_layer": f"{weak.describe()}: {_name(weak)}"}
+    out["profile"] = {**prof, "sha256": digest, "weak_layer": f"{describe(col)}; in {weak.describe()}: {_name(weak)}"}
     return out
+
+
+def follow_grid(table: dict) -> None:
+    """The grid and margin a column needs, where the table does not give them: ``dx`` resolves the weak layer with
+    :data:`CELLS_ACROSS` cells, the margin is at least 2 dx (``table``, a ``[scene]`` table, is changed)."""
+    if "dx" not in table:
+        table["dx"] = table["weak_layer_thickness"] / CELLS_ACROSS
+    if "margin" not in table:
+        table["margin"] = max(0.05, 2.0 * table["dx"])
 
 
 def _name(ly) -> str:
@@ -147,7 +172,6 @@ def _name(ly) -> str:
     return " ".join(s for s in (grains, ly.hardness or "") if s) or f"layer {ly.index}"
 
 
-def _layer(ly, scale: float) -> dict:
-    """A profile layer as a ``slab_layers`` entry: bed-normal thickness, density; E from the density."""
-    return {"thickness": ly.thickness * scale, "density": float(ly.density),
-            "name": f"{_name(ly)}, {ly.density:.0f} kg/m3 ({'measured' if ly.measured else 'from hardness'})"}
+def _layer(part, scale: float) -> dict:
+    """A column part as a ``slab_layers`` entry: bed-normal thickness, density; E from the density."""
+    return {"thickness": part.thickness * scale, "density": part.density, "name": part.name}

@@ -22,6 +22,8 @@ CALIBRATION_RTOL = 1e-3
 _CALIBRATION_INCREMENTS = 800  # shear increments of a calibration run: w_f within ~1e-3 of the converged value
 _MAX_CALIBRATION_RUNS = 12
 _CALIBRATION_ACCEPT = 1e-2  # relative error accepted when the secant stalls on the increment's resolution
+_MAX_LOG_STEP = math.log(10.0)  # a secant step changes kappa_s by at most 10x: a flat stretch cannot throw it out
+_K_SPAN = 1e6  # kappa_s stays within 1e6x of its start either way: beyond, the target is out of the test's reach
 
 
 def shear_range(mat, sigma_n: float, tau: float) -> float:
@@ -74,10 +76,19 @@ def fit_kappa_s(mat0, sigma_n: float, D_wl: float, key: str, target: float, tau_
             # can stall just above the tolerance: keep the best run when it is within the resolution
             err, k, r = min(runs, key=lambda e: e[0])
             if err > _CALIBRATION_ACCEPT:
-                raise InvalidArgument(key, target, f"a value the shear test can reach (after {len(hist)} runs it "
-                                                   f"gives {r[key]:.4g})")
+                e = InvalidArgument(key, target, f"a value the shear test can reach (after {len(hist)} runs it "
+                                                 f"gives {r[key]:.4g})")
+                e.reached = r[key]
+                raise e
             break
         (x0, e0), (x1, e1) = hist[-2] if len(hist) > 1 else hist[-1], hist[-1]
-        k = math.exp(x1 - e1 * (x1 - x0) / (e1 - e0)) if e1 != e0 else k * target / r[key]
+        step = -e1 * (x1 - x0) / (e1 - e0) if e1 != e0 else -e1
+        x = x1 + max(-_MAX_LOG_STEP, min(_MAX_LOG_STEP, step))
+        if abs(x - hist[0][0]) > math.log(_K_SPAN):
+            e = InvalidArgument(key, target, f"a value the shear test can reach (it gives {r[key]:.4g} at the end "
+                                             "of its range)")
+            e.reached = r[key]
+            raise e
+        k = math.exp(x)
     info = {"runs": len(hist), "n_increments": n, "relative_error": math.expm1(abs(err)), "target": key}
     return replace(mat0, kappa_s=k), r, info
