@@ -15,7 +15,7 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BENCH = os.path.join(ROOT, "benchmarks")
 FILES = sorted(os.path.relpath(p, BENCH) for p in glob.glob(os.path.join(BENCH, "*", "*.py")))
-GROUPS = ("perf", "convergence", "snow", "robustness")
+GROUPS = ("perf", "convergence", "snow", "field", "robustness")
 
 
 def _source(rel: str) -> str:
