@@ -332,7 +332,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     rs = sub.add_parser("resume", help="continue a run from its last checkpoint")
     rs.add_argument("run", help="the run's HDF5 file (its checkpoint RUN.ckpt.h5 must sit beside it)")
-    rs.add_argument("--device", default=None)
+    rs.add_argument("--device", default=None, help="as for run (default: MPM_WARP_DEVICE, then CUDA if present)")
     rs.add_argument("--end", type=float, default=None, help="new end time (s), after the run file's last frame")
     rs.add_argument("--max-memory", default=None, metavar="SIZE", help="as for run")
     rs.add_argument("--quiet", action="store_true", help="no progress bar")

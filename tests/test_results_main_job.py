@@ -55,7 +55,8 @@ def test_main_job_section_and_readme_line(tmp_path):
     assert ("The main job: 1,000 particles, 2,000 steps, 5 frames, 0.0 M particle-steps/s over the run's wall time "
             "(compiling and pictures included); it wrote `pst.png`.") in lines
     assert main_job_block(ctx) == [
-        "Measured from a fresh clone on a 2-core CPU (load average 0.8 at the start, 2026-12-02): the install took "
+        "Measured from a fresh clone on a 2-core CPU (2026-12-02; the machine's load is in the linked section): "
+        "the install took "
         "23 s, the run with its pictures 200 s; the test command below 603 s "
         "([The main job](docs/results.md#the-main-job))."]
     FRESH["ok"] = False                      # a failed command is not quoted in the README

@@ -48,7 +48,7 @@ class ShearTestParams:
     sample_length : float
         Sample length L_s (m), > 0.
     weak_layer_thickness : float
-        D_wl (m), at least 2 grid cells.
+        D_wl (m), at least 3 grid cells (:data:`~mpm_warp.scenes.snow.MIN_WEAK_LAYER_CELLS`, as the PST's).
     load_thickness : float
         Thickness t of the loading block (m), >= 2 dx; its density ``sigma_n / (g t)`` gives the slab's load.
     width : float

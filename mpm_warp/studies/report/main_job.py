@@ -59,8 +59,8 @@ def main_job_block(ctx: Context) -> list[str] | None:
     run = _part(parts, "mpm-warp run")
     tests = sum(p["wall_s"] for p in (data.get("tests") or {}).get("parts", []))
     env = environment_of(data)
-    load = f"load average {fx(env['load'], 1)} at the start" if finite(env["load"]) else "load not recorded"
-    line = (f"Measured from a fresh clone on a {env['cpu_count']}-core CPU ({load}, {env['date']}): the install "
+    line = (f"Measured from a fresh clone on a {env['cpu_count']}-core CPU ({env['date']}; the machine's load is in "
+            f"the linked section): the install "
             f"took {secs(install)}, the run with its pictures {secs(run['wall_s'])}")
     if tests:
         line += f"; the test command below {secs(tests)}"

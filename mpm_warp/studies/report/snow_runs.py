@@ -127,12 +127,25 @@ for _name in ("pst_flat", "pst_slope"):
 
 
 # ----------------------------------------------------------------------------- critical cut
+def _in_todays_keys(case: dict) -> tuple[float, str, list[str], bool]:
+    """A critical-cut case's slope (deg, >= 0), the end the saw starts from and its overrides in today's keys,
+    and whether the JSON records the older form: before ``saw.cut_from`` a negative ``scene.slope_angle`` meant
+    the cut from the downslope end; today it only mirrors the column (``params.upgrade_table``)."""
+    overrides = list(case.get("overrides") or [])
+    th = float(case.get("slope_angle") or 0.0)
+    given = [o.split("=", 1)[1].strip("'\"") for o in overrides if o.startswith("scene.saw.cut_from=")]
+    if th < 0.0 and not given:
+        overrides = [o for o in overrides if not o.startswith("scene.slope_angle=")]
+        return -th, "downslope", overrides + [f"scene.slope_angle={-th:g}", "scene.saw.cut_from='downslope'"], True
+    return abs(th), (given[-1] if given else "upslope"), overrides, False
+
+
 def _weac_key(case: dict) -> str | None:
     """The weac ladder case of a critical-cut case on the ladder PST (by its slope and cut end), else None."""
     if not all(o in (case.get("overrides") or []) for o in LADDER_PST):
         return None
-    th = case.get("slope_angle", 0.0)
-    return "flat" if th == 0 else f"{'upslope' if th > 0 else 'downslope'}_{abs(th):g}"
+    th, end, _, _ = _in_todays_keys(case)
+    return "flat" if th == 0 else f"{end}_{th:g}"
 
 
 def _ladder_reference(ctx, dx: float):
@@ -150,32 +163,39 @@ def _ladder_reference(ctx, dx: float):
                   "stop position, trial runs forked from one base run.)")
 def render_critical_cut(data: dict, ctx) -> list[str]:
     weac = (ctx.load("snow/results/weac_static_pst.json") or {}).get("ladder") or {}
-    rows, overrides, vals = [], [], []
+    rows, overrides, vals, older = [], [], [], []
     for name, c in data["cases"].items():
+        slope, end, todays, was_older = _in_todays_keys(c)
+        if was_older:
+            older.append(name)
         ref = _ladder_reference(ctx, c["dx"]) if _weac_key(c) else None
         wk = _weac_key(c)
         w = (weac.get(wk) or {}).get("critical_cut") if wk else None
         v = c.get("value")
         if c.get("bracketed"):
             vals.append(v)
-        rows.append([f"`{name}`", f"`{c['scene']}`", fx(c["dx"] * 1e3, 1), fx(c.get("slope_angle"), 0),
+        rows.append([f"`{name}`", f"`{c['scene']}`", fx(c["dx"] * 1e3, 1), fx(slope, 0), end,
                      fx(c.get("saw_speed"), 2), bracket(v, c["lo"], c["hi"]) if c.get("bracketed") else
                      (c.get("note") or DASH), len(c.get("trials") or []),
                      spct(v / ref["critical_cut"] - 1) if ref and finite(v) else DASH,
                      f"{fx(w, 3)} m ({spct(v / w - 1)})" if finite(w) and finite(v) else DASH,
                      fx(c.get("gaume"), 3), fx(c.get("runaway_cut_of_base"), 3), fx(c.get("base_speed_mean"), 1),
                      secs(c.get("wall_s"))])
-        overrides.append(f"- `{name}`: `{c['scene']}` with " + " ".join(f"`{o}`" for o in c.get("overrides") or []))
-    out = table(["case", "scene", "dx (mm)", "slope (deg)", "saw (m/s)", "critical cut (m)", "trials",
+        overrides.append(f"- `{name}`: `{c['scene']}` with " + " ".join(f"`{o}`" for o in todays))
+    out = table(["case", "scene", "dx (mm)", "slope (deg)", "cut from", "saw (m/s)", "critical cut (m)", "trials",
                  "against the flat ladder at that dx", "weac (static)", "Gaume 2017 (m)",
                  "base run: saw when the crack left it (m)", "base run: speed (m/s)", "wall time"], rows)
     out += ["", env_note(*data["cases"].values()), "", "The cases' columns (scenario overrides):", ""] + overrides
+    if older:
+        names = ", ".join(f"`{n}`" for n in older)
+        out += ["", f"The overrides are in today's keys; the JSON of {names} records the older form, a negative "
+                "`scene.slope_angle`, which meant the cut from the downslope end before `scene.saw.cut_from` existed; "
+                "today a negative angle only mirrors the column."]
     if vals:
         inside = all(FIELD_CUT[0] <= v <= FIELD_CUT[1] for v in vals)
         out += ["", f"Every bracketed cut {'lies' if inside else 'does not lie'} within the field's "
-                f"{FIELD_CUT[0]:g}-{FIELD_CUT[1]:g} m ({fx(min(vals), 3)}-{fx(max(vals), 3)} m). The slope angle is "
-                "positive when the saw cuts from the upslope end; weac's column is the ladder's, static, with "
-                "its energy criterion at the same fracture energy."]
+                f"{FIELD_CUT[0]:g}-{FIELD_CUT[1]:g} m ({fx(min(vals), 3)}-{fx(max(vals), 3)} m). weac's column is the "
+                "ladder's, static, with its energy criterion at the same fracture energy."]
     return out
 
 
