@@ -49,6 +49,7 @@ import time
 from mpm_warp.errors import SimulationBlowUp
 from mpm_warp.studies.convergence import observed_order, time_to_target
 from mpm_warp.studies.environment import environment
+from mpm_warp.studies.finite_json import dump_finite
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import PROBLEMS
 
@@ -280,7 +281,7 @@ def main(argv=None) -> int:
             p["summary"] = summarise(name, p["dx_ladder"], p["dt_ladder"])
             data["wall_time_benchmark_s"] = time.perf_counter() - t_all
             with open(path + ".tmp", "w") as fh:
-                json.dump(data, fh, indent=1, default=float)
+                dump_finite(data, fh, indent=1, default=float)
             os.replace(path + ".tmp", path)
         s = p["summary"]
         print(f"{name}: order in dx {_f(s['observed_order_dx'])}, time to 1 %: {s['time_to_1pct']}", flush=True)
