@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .analysis import end_zone
+from .analysis import crack_ran, end_zone
 from .params import PSTParams
 
 __all__ = ["SlabCrackDetector", "classify", "field_line", "THROUGH_DAMAGE", "THROUGH_COVER", "STALL_TIME"]
@@ -116,7 +116,7 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
     fr = np.asarray(front, dtype=float)
     L, D = float(params.length), float(params.slab_depth) / math.cos(math.radians(params.slope_angle))
     cut = float(params.saw.cut_length) if saw_cut is None or not math.isfinite(saw_cut) else float(saw_cut)
-    reach_end = np.nonzero(fr >= L - end_zone(params))[0]
+    reach_end = np.nonzero((fr >= L - end_zone(params)) & crack_ran(params, fr))[0]
     t_end = float(t[reach_end[0]]) if len(reach_end) else math.nan
     sc = np.full(len(t), np.nan) if slab_crack is None else np.asarray(slab_crack, dtype=float)
     broke = np.nonzero(np.isfinite(sc))[0]
@@ -138,7 +138,8 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
             out["note"] = f"the crack ran {fr[-1] - float(params.saw.cut_length):.2f} m beyond the saw and stopped"
     else:
         cls = None
-        out["note"] = "the crack was still running when the run ended (lengthen time.end to classify it)"
+        out["note"] = ("the saw had not started when the run ended" if not len(t) or t[-1] < params.saw_start else
+                       "the crack was still running when the run ended") + " (lengthen time.end to classify it)"
     out["class"] = cls
     out["field_line"] = field_line(cls, cut, L, D)
     return out
