@@ -62,14 +62,15 @@ def _version_str(v) -> str | None:
     return ".".join(str(p) for p in v) if v else None
 
 
-def write_json(name: str, data: dict, results_dir: str) -> str:
+def write_json(name: str, data: dict, results_dir: str, end_load: bool = True) -> str:
     """Write ``<results_dir>/<name>.json`` (through a temporary file, so a kill leaves the old one); return its path.
 
     When ``data`` has an ``environment`` the load average at writing time is added beside the one at
-    the start (how busy the shared machine was). No inf or NaN is written: a non-finite number becomes null
+    the start (how busy the shared machine was), unless ``end_load`` is False (a result re-derived from a
+    stored run keeps its run's record). No inf or NaN is written: a non-finite number becomes null
     with its reason under ``<key>_null`` (:func:`~mpm_warp.studies.finite_json.finite_json`).
     """
-    if isinstance(data.get("environment"), dict):
+    if end_load and isinstance(data.get("environment"), dict):
         data["environment"]["load_average_at_end_1_5_15_min"] = list(os.getloadavg())
     os.makedirs(results_dir, exist_ok=True)
     path = os.path.join(results_dir, name + ".json")

@@ -19,8 +19,8 @@ from ..fronts import front_trajectory, lead_ahead_of_front
 from ..references import heierli_speed, heierli_touchdown
 from .params import PSTParams
 
-__all__ = ["pst_summary", "front_speeds", "end_zone", "runaway_cut", "slab_p_wave_speed", "crack_ran",
-           "SPEED_WINDOW", "MEAN_SPEED_DISTANCE", "SPEED_LIMIT_DISTANCE"]
+__all__ = ["pst_summary", "front_speeds", "rederive_speeds", "end_zone", "runaway_cut", "slab_p_wave_speed",
+           "crack_ran", "SPEED_WINDOW", "MEAN_SPEED_DISTANCE", "SPEED_LIMIT_DISTANCE"]
 
 #: window of the local front speed (m)
 SPEED_WINDOW = 0.5
@@ -94,6 +94,48 @@ def runaway_cut(params: PSTParams, s, t_arrival) -> float:
     return float(saw[k[0]]) if len(k) else math.nan
 
 
+def _reach_and_speed(params: PSTParams, out: dict) -> None:
+    """``p_wave_speed``, ``propagated``, ``ran_to_end``, ``speed`` and ``front_agreement`` into ``out``, from its
+    fronts' reach and mean speeds (:func:`pst_summary`)."""
+    cut, L = float(params.saw.cut_length), float(params.length)
+    out["p_wave_speed"] = slab_p_wave_speed(params)
+    reach = out["damage_front_final"]
+    ran = crack_ran(params, reach)
+    out["propagated"] = bool(ran and reach >= min(cut + 2.0, L - end_zone(params)))
+    out["ran_to_end"] = bool(ran and reach >= L - end_zone(params))
+    out["speed"] = out["damage_speed_mean"]
+    out.pop("speed_null", None)
+    if "damage_speed_mean_null" in out:
+        out["speed_null"] = out["damage_speed_mean_null"]
+    v1, v2 = out["damage_speed_mean"], out["deflection_speed_mean"]
+    out["front_agreement"] = v2 / v1 if np.isfinite(v1) and np.isfinite(v2) and v1 > 0 else math.nan
+    out.pop("front_agreement_null", None)
+    _null(out, "front_agreement", "no mean speed of both fronts")
+
+
+def rederive_speeds(params: PSTParams, result: dict) -> dict:
+    """A stored PST result (:func:`pst_summary`, as a results file holds it) with its speeds re-derived from its
+    fronts' paths (``damage_path``, ``deflection_path``) by today's analysis.
+
+    The paths are the contiguous fronts; the bins' own arrival times are not stored, so the damage ahead is
+    what the paths show (``{prefix}_jumps``); ``{prefix}_ahead`` is None with the reason, and the run's
+    ``max_damage_lead`` (from the arrival times) stays. Every other value is kept.
+    """
+    out = dict(result)
+    for prefix in ("damage", "deflection"):
+        for key in [k for k in out if k.startswith(f"{prefix}_speed")]:
+            del out[key]
+        path = result[f"{prefix}_path"]
+        sp = np.asarray([math.nan if v is None else v for v in path["s"]], dtype=float)
+        T = np.asarray([math.nan if v is None else v for v in path["t"]], dtype=float)
+        out.update(front_speeds(params, sp, T, prefix))
+        out[f"{prefix}_ahead"] = None
+        out[f"{prefix}_ahead_null"] = ("the bins' arrival times were not stored: the damage ahead is what the "
+                                       f"path shows ({prefix}_jumps; max_damage_lead from the run's arrival times)")
+    _reach_and_speed(params, out)
+    return out
+
+
 def pst_summary(params: PSTParams, calibration, times, series: dict, s_bins, t_damage, t_deflection) -> dict:
     """Crack fronts, speeds, touchdown and collapse of a PST.
 
@@ -139,17 +181,7 @@ def pst_summary(params: PSTParams, calibration, times, series: dict, s_bins, t_d
     out = {"cut_length": cut, "column_length": L}
     out.update(_front(params, s_bins, t_damage, "damage"))
     out.update(_front(params, s_bins, t_deflection, "deflection"))
-    out["p_wave_speed"] = slab_p_wave_speed(params)
-    reach = out["damage_front_final"]
-    ran = crack_ran(params, reach)
-    out["propagated"] = bool(ran and reach >= min(cut + 2.0, L - end_zone(params)))
-    out["ran_to_end"] = bool(ran and reach >= L - end_zone(params))
-    out["speed"] = out["damage_speed_mean"]
-    if "damage_speed_mean_null" in out:
-        out["speed_null"] = out["damage_speed_mean_null"]
-    v1, v2 = out["damage_speed_mean"], out["deflection_speed_mean"]
-    out["front_agreement"] = v2 / v1 if np.isfinite(v1) and np.isfinite(v2) and v1 > 0 else math.nan
-    _null(out, "front_agreement", "no mean speed of both fronts")
+    _reach_and_speed(params, out)
     out["runaway_cut"] = runaway_cut(params, s_bins, t_damage)
     _null(out, "runaway_cut", f"the damage front never led the blade by {params.front.runaway_lead:g} m")
     out["max_damage_lead"], out["max_damage_lead_at"] = lead_ahead_of_front(s_bins, t_damage)
