@@ -161,3 +161,27 @@ def test_finite_json_writes_null_with_a_reason():
     fh = io.StringIO()
     dump_finite(data, fh)
     assert "NaN" not in fh.getvalue() and "Infinity" not in fh.getvalue()
+
+
+def test_rederive_speeds_of_a_stored_result():
+    from mpm_warp.scenes.pst.analysis import rederive_speeds
+    p = _pst()
+    t, _ = _nucleated(30.0, (5.0, 5.6))
+    times = np.arange(0.0, 0.8, 0.002)
+    series = {"front": np.array([fronts.front_from_arrival(t, ti, BW) for ti in times])}
+    out = pst_summary(p, p.calibrated(), times, series, S, t, t)
+    stored = json.loads(json.dumps(finite_json(out)))
+    # as an older release stored it: the old profile (a speed far above c_p), no jumps
+    sp, T = fronts.front_trajectory(S, t)
+    mids, old = fronts.speed_profile(sp, T, 0.5, start=CUT)
+    for key in ("damage_ahead", "damage_jumps", "p_wave_speed"):
+        stored.pop(key)
+    stored["damage_speed_profile"] = {"s": mids.tolist(), "speed": old.tolist()}
+    again = rederive_speeds(p, stored)
+    assert list(again)[:5] == list(stored)[:5]                  # the stored order kept
+    prof = again["damage_speed_profile"]
+    assert prof["status"].count(NUCLEATION) == 4 and max(v for v in prof["speed"] if v is not None) <= 30.0 + 1e-6
+    (j,) = again["damage_jumps"]
+    assert (j["start"], j["end"]) == pytest.approx((4.99, 5.59)) and again["damage_ahead"] is None
+    assert "not stored" in again["damage_ahead_null"] and again["p_wave_speed"] == pytest.approx(C_P, rel=1e-3)
+    assert again["damage_speed_mean"] == pytest.approx(30.0, rel=1e-6) and again["ran_to_end"]

@@ -121,17 +121,23 @@ def rederive_speeds(params: PSTParams, result: dict) -> dict:
     what the paths show (``{prefix}_jumps``); ``{prefix}_ahead`` is None with the reason, and the run's
     ``max_damage_lead`` (from the arrival times) stays. Every other value is kept.
     """
-    out = dict(result)
+    new = {}
     for prefix in ("damage", "deflection"):
-        for key in [k for k in out if k.startswith(f"{prefix}_speed")]:
-            del out[key]
         path = result[f"{prefix}_path"]
         sp = np.asarray([math.nan if v is None else v for v in path["s"]], dtype=float)
         T = np.asarray([math.nan if v is None else v for v in path["t"]], dtype=float)
-        out.update(front_speeds(params, sp, T, prefix))
-        out[f"{prefix}_ahead"] = None
-        out[f"{prefix}_ahead_null"] = ("the bins' arrival times were not stored: the damage ahead is what the "
-                                       f"path shows ({prefix}_jumps; max_damage_lead from the run's arrival times)")
+        new[prefix] = {**front_speeds(params, sp, T, prefix), f"{prefix}_ahead": None,
+                       f"{prefix}_ahead_null": ("the bins' arrival times were not stored: the damage ahead is what "
+                                                f"the path shows ({prefix}_jumps; max_damage_lead from the run's "
+                                                "arrival times)")}
+    out = {}
+    for key, value in result.items():                 # the stored order, the speeds in place of the old ones
+        prefix = next((p for p in new if key.startswith(f"{p}_speed") or key in (f"{p}_ahead", f"{p}_jumps")),
+                      None)
+        if prefix is None:
+            out[key] = value
+        elif f"{prefix}_speed_mean" not in out:
+            out.update(new[prefix])
     _reach_and_speed(params, out)
     return out
 
