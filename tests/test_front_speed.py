@@ -185,3 +185,14 @@ def test_rederive_speeds_of_a_stored_result():
     assert (j["start"], j["end"]) == pytest.approx((4.99, 5.59)) and again["damage_ahead"] is None
     assert "not stored" in again["damage_ahead_null"] and again["p_wave_speed"] == pytest.approx(C_P, rel=1e-3)
     assert again["damage_speed_mean"] == pytest.approx(30.0, rel=1e-6) and again["ran_to_end"]
+
+
+def test_load_json_reads_back_nan_where_the_writer_put_null():
+    from mpm_warp.studies.finite_json import load_json
+    data = {"a": math.nan, "b": None, "c": [1.0, math.inf], "d": {"e": math.nan, "f": "x"}, "g": [None, 2.0]}
+    fh = io.StringIO()
+    dump_finite(data, fh)
+    fh.seek(0)
+    back = load_json(fh)
+    assert math.isnan(back["a"]) and back["b"] is None and back["c"][0] == 1.0 and math.isnan(back["c"][1])
+    assert math.isnan(back["d"]["e"]) and back["d"]["f"] == "x" and back["g"] == [None, 2.0]

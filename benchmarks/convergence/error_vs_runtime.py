@@ -39,7 +39,6 @@ The convergence arithmetic (orders, time to an error) is :mod:`mpm_warp.studies.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import statistics
@@ -49,7 +48,7 @@ import time
 from mpm_warp.errors import SimulationBlowUp
 from mpm_warp.studies.convergence import observed_order, time_to_target
 from mpm_warp.studies.environment import environment
-from mpm_warp.studies.finite_json import dump_finite
+from mpm_warp.studies.finite_json import dump_finite, load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import PROBLEMS
 
@@ -250,7 +249,7 @@ def main(argv=None) -> int:
     path, stem = os.path.join(folder, name + ".json"), os.path.join(folder, name)
     if a.plot_only:
         with open(path) as fh:
-            data = json.load(fh)
+            data = load_json(fh)
         plot(data, stem + ".png")
         with open(stem + ".md", "w") as fh:
             fh.write(markdown(data))

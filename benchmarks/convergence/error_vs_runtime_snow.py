@@ -61,6 +61,7 @@ from mpm_warp.memory import estimate_memory
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.studies.convergence import ladder_summary
 from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import PST_BRACKET, PST_DX, SHEAR_CELLS, grid_bracket, ladder_pst, merge_pst_parts, pst_part
 
@@ -266,7 +267,7 @@ def load(results: str, name: str = OUT) -> dict:
     path = os.path.join(results, name + ".json")
     if os.path.isfile(path):
         with open(path) as fh:
-            return json.load(fh)
+            return load_json(fh)
     return {"ladders": {"pst": [], "shear": []}, "summary": {}}
 
 

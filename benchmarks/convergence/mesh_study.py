@@ -43,7 +43,6 @@ recomputes the summary and redraws from the JSON.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import sys
@@ -56,7 +55,7 @@ from mpm_warp.camclay_forms import oedometric_ratio
 from mpm_warp.materials import hardening_collapse
 from mpm_warp.studies.convergence import observed_order
 from mpm_warp.studies.environment import environment
-from mpm_warp.studies.finite_json import dump_finite
+from mpm_warp.studies.finite_json import dump_finite, load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import G, oedometric_collapse, run_column, weak_layer_column
 
@@ -202,7 +201,7 @@ def main(argv=None) -> int:
     path, png = os.path.join(folder, name + ".json"), os.path.join(folder, name + ".png")
     if a.plot_only:
         with open(path) as fh:
-            data = json.load(fh)
+            data = load_json(fh)
         data["summary"] = summarise(data["runs"])
         _write(path, data)
         plot(data, png)

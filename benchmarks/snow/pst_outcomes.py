@@ -26,7 +26,6 @@ Usage::
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 import sys
 import time
@@ -37,6 +36,7 @@ from mpm_warp.scenes.pst.static import static_column
 from mpm_warp.scenes.snowpack import SnowLayer
 from mpm_warp.scenes.weac_reference import slab_stress, weac_unavailable
 from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -124,7 +124,7 @@ def main(argv=None) -> int:
     old = os.path.join(folder, OUT + ".json")
     if os.path.isfile(old) and not a.quick:
         with open(old) as fh:
-            data = json.load(fh)
+            data = load_json(fh)
     for name in names:
         data["cases"][name] = run_case(name, folder, a.device)
         print("wrote", write_json(OUT, data, folder), flush=True)

@@ -4,6 +4,9 @@
 reason under ``<key>_null`` (unless the producer gave one already: e.g. "the front did not reach 3.8 m: no
 speed"). :func:`~mpm_warp.studies.environment.write_json` writes through it with ``allow_nan=False``.
 
+:func:`load_json` reads such a file back with nan where the writer put null for a number (the nulls with a
+``<key>_null`` reason beside them), so code that computes with the values reads what it wrote.
+
 ``python -m mpm_warp.studies.finite_json FILE...`` rewrites results files of older releases this way (values
 unchanged; ``NaN`` and ``Infinity`` tokens become null with a reason).
 """
@@ -18,7 +21,7 @@ import sys
 
 import numpy as np
 
-__all__ = ["finite_json", "non_finite_reason", "dump_finite", "main"]
+__all__ = ["finite_json", "non_finite_reason", "dump_finite", "load_json", "with_nan", "main"]
 
 
 def non_finite_reason(v) -> str | None:
@@ -66,6 +69,32 @@ def finite_json(obj):
 def dump_finite(data, fh, **kwargs) -> None:
     """``json.dump`` of :func:`finite_json` of ``data`` (``allow_nan=False``: a non-finite number left raises)."""
     json.dump(finite_json(data), fh, allow_nan=False, **kwargs)
+
+
+def with_nan(obj):
+    """``obj`` read from a results file with nan for every null the writer put for a non-finite number: an entry
+    ``k`` (or the entries of a list ``k``) of a dict that has ``k + "_null"``. Other nulls stay None."""
+    if isinstance(obj, dict):
+        out = {}
+        for k, v in obj.items():
+            if f"{k}_null" in obj and isinstance(obj[f"{k}_null"], str):
+                if v is None:
+                    v = math.nan
+                elif isinstance(v, list):
+                    v = [math.nan if x is None else x for x in v]
+            out[k] = with_nan(v)
+        return out
+    if isinstance(obj, list):
+        return [with_nan(v) for v in obj]
+    return obj
+
+
+def load_json(source):
+    """A results file (a path or an open file) through :func:`with_nan`."""
+    if isinstance(source, (str, os.PathLike)):
+        with open(source) as fh:
+            return with_nan(json.load(fh))
+    return with_nan(json.load(source))
 
 
 def main(argv=None) -> int:
