@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from mpm_warp.finite_json import dump_finite, finite_json
 from mpm_warp.scenes import fronts
 from mpm_warp.scenes.front_speed import (
     CONTIGUOUS,
@@ -21,7 +22,6 @@ from mpm_warp.scenes.front_speed import (
 from mpm_warp.scenes.pst import Front, PSTParams, Saw, pst_summary
 from mpm_warp.scenes.pst.analysis import slab_p_wave_speed
 from mpm_warp.scenes.snow import Settle
-from mpm_warp.studies.finite_json import dump_finite, finite_json
 
 BW = 0.02            # m: bin width
 CUT, L, T0 = 0.4, 6.0, 0.5
@@ -188,7 +188,7 @@ def test_rederive_speeds_of_a_stored_result():
 
 
 def test_load_json_reads_back_nan_where_the_writer_put_null():
-    from mpm_warp.studies.finite_json import load_json
+    from mpm_warp.finite_json import load_json
     data = {"a": math.nan, "b": None, "c": [1.0, math.inf], "d": {"e": math.nan, "f": "x"}, "g": [None, 2.0]}
     fh = io.StringIO()
     dump_finite(data, fh)

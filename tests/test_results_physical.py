@@ -77,7 +77,7 @@ def test_committed_result_is_finite_and_slower_than_sound(path):
         pytest.skip(KNOWN_EXCEPTIONS[rel])
     data, bad = _numbers(path)
     assert not bad, f"{rel} holds {len(bad)} non-finite numbers ({sorted(set(bad))}): write it through " \
-                    "mpm_warp.studies.finite_json (null with its reason)"
+                    "mpm_warp.finite_json (null with its reason)"
     over = []
     _speeds_over(data, DEFAULT_CP, "", over)
     assert not over, f"{rel}: speeds above c_p outside '{NUCLEATION}': {over[:5]}"

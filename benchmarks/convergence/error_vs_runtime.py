@@ -46,9 +46,9 @@ import sys
 import time
 
 from mpm_warp.errors import SimulationBlowUp
+from mpm_warp.finite_json import dump_finite, load_json
 from mpm_warp.studies.convergence import observed_order, time_to_target
 from mpm_warp.studies.environment import environment
-from mpm_warp.studies.finite_json import dump_finite, load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import PROBLEMS
 

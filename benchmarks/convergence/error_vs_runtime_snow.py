@@ -57,11 +57,11 @@ import numpy as np
 
 import mpm_warp as mw
 from mpm_warp.errors import InvalidArgument
+from mpm_warp.finite_json import load_json
 from mpm_warp.memory import estimate_memory
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.studies.convergence import ladder_summary
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import PST_BRACKET, PST_DX, SHEAR_CELLS, grid_bracket, ladder_pst, merge_pst_parts, pst_part
 

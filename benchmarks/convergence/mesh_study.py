@@ -52,10 +52,10 @@ import numpy as np
 
 import mpm_warp as mw
 from mpm_warp.camclay_forms import oedometric_ratio
+from mpm_warp.finite_json import dump_finite, load_json
 from mpm_warp.materials import hardening_collapse
 from mpm_warp.studies.convergence import observed_order
 from mpm_warp.studies.environment import environment
-from mpm_warp.studies.finite_json import dump_finite, load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import G, oedometric_collapse, run_column, weak_layer_column
 

@@ -25,10 +25,10 @@ import sys
 import time
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes import attach
 from mpm_warp.studies.blocks import block_scenario
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser, result_name
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")

@@ -30,9 +30,9 @@ import time
 import warp_block
 from taichi_peer import run_taichi_block_subprocess
 
+from mpm_warp.finite_json import load_json
 from mpm_warp.studies import plastic_block as pb
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")

@@ -34,11 +34,11 @@ import sys
 import time
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.pst.static import weac_answer
 from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import FIELD_CUT, ladder_pst
 

@@ -27,11 +27,11 @@ import time
 import numpy as np
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.shear_test import shear_curves
 from mpm_warp.studies import interface_model1d
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.interface_column import column_rows, free_column_rows, running_rows, step_cost
 from mpm_warp.studies.protocol import out_dir, parser, result_name
 from mpm_warp.studies.snow import PST_BRACKET, PST_DX, ladder_pst

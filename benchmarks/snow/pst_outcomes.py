@@ -31,12 +31,12 @@ import sys
 import time
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.post.pst_picture import pst_picture
 from mpm_warp.scenes.pst.static import static_column
 from mpm_warp.scenes.snowpack import SnowLayer
 from mpm_warp.scenes.weac_reference import slab_stress, weac_unavailable
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser
 
 HERE = os.path.dirname(os.path.abspath(__file__))

@@ -31,10 +31,10 @@ import sys
 import time
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.snowpack import SnowLayer
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import ladder_pst
 

@@ -34,11 +34,11 @@ import time
 
 import numpy as np
 
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.convergence import loglog_slope
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.fanout import dask_map
-from mpm_warp.studies.finite_json import load_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import FIELD_SPEED, ladder_pst
 

@@ -10,8 +10,8 @@ import subprocess
 
 import warp as wp
 
+from ..finite_json import dump_finite
 from ..result import versions
-from .finite_json import dump_finite
 
 __all__ = ["environment", "git_commit", "write_json"]
 
@@ -68,7 +68,7 @@ def write_json(name: str, data: dict, results_dir: str, end_load: bool = True) -
     When ``data`` has an ``environment`` the load average at writing time is added beside the one at
     the start (how busy the shared machine was), unless ``end_load`` is False (a result re-derived from a
     stored run keeps its run's record). No inf or NaN is written: a non-finite number becomes null
-    with its reason under ``<key>_null`` (:func:`~mpm_warp.studies.finite_json.finite_json`).
+    with its reason under ``<key>_null`` (:func:`~mpm_warp.finite_json.finite_json`).
     """
     if end_load and isinstance(data.get("environment"), dict):
         data["environment"]["load_average_at_end_1_5_15_min"] = list(os.getloadavg())

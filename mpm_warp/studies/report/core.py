@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ...errors import InvalidArgument
-from ..finite_json import load_json
+from ...finite_json import load_json
 from .fmt import environment_of
 
 __all__ = ["PARTS", "Section", "Context", "SECTIONS", "section", "pending", "document", "slug"]

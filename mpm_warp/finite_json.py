@@ -7,7 +7,7 @@ speed"). :func:`~mpm_warp.studies.environment.write_json` writes through it with
 :func:`load_json` reads such a file back with nan where the writer put null for a number (the nulls with a
 ``<key>_null`` reason beside them), so code that computes with the values reads what it wrote.
 
-``python -m mpm_warp.studies.finite_json FILE...`` rewrites results files of older releases this way (values
+``python -m mpm_warp.finite_json FILE...`` rewrites results files of older releases this way (values
 unchanged; ``NaN`` and ``Infinity`` tokens become null with a reason).
 """
 
