@@ -142,4 +142,5 @@ def test_a_column_no_longer_than_its_slab_is_refused_and_a_short_run_has_no_outc
     assert not r["propagated"] and not r["ran_to_end"] and r["damage_front_final"] == 0.0
     assert r["outcome"]["class"] is None and r["outcome"]["field_line"] == "PST 10/45 (running) down 30 cm"
     assert r["outcome"]["note"].startswith("the saw had not started") and math.isnan(r["outcome"]["end_time"])
+    assert r["outcome"]["end_time_null"] == "the crack did not reach the far end zone, having run beyond the cut"
     assert math.isnan(r["speed"]) and "did not reach 0.15 m" in r["speed_null"]

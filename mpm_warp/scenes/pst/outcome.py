@@ -110,7 +110,7 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
         ``field_line`` (:func:`field_line`), ``cut``, ``column_length``, ``depth`` (m, vertical: the slab's
         bed-normal thickness over the cosine of the slope), ``end_time``,
         ``slab_fracture_time`` (s, nan: never), ``slab_fracture_at`` (m from the cut end, nan), ``arrest_at``
-        (m from the cut end for ARR, nan otherwise), ``note``.
+        (m from the cut end for ARR, nan otherwise), ``note``; a nan value has its reason under ``<key>_null``.
     """
     t = np.asarray(times, dtype=float)
     fr = np.asarray(front, dtype=float)
@@ -142,7 +142,16 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
                        "the crack was still running when the run ended") + " (lengthen time.end to classify it)"
     out["class"] = cls
     out["field_line"] = field_line(cls, cut, L, D)
+    for key, why in _NAN_REASONS.items():
+        if not math.isfinite(out[key]):
+            out[f"{key}_null"] = why
     return out
+
+
+#: why a value of :func:`classify` is nan (null in a results file)
+_NAN_REASONS = {"end_time": "the crack did not reach the far end zone, having run beyond the cut",
+                "slab_fracture_time": "the slab did not crack through", "slab_fracture_at": "not an SF outcome",
+                "arrest_at": "not an ARR outcome"}
 
 
 def _stalled(t, front, params: PSTParams) -> bool:
