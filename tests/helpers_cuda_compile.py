@@ -66,8 +66,9 @@ _GEOMETRIES = {
     "pst": {"2d": _PST, "slab": _PST + ["scene.plane_strain='slab'"], "3d": _PST + ["scene.width=0.02"]},
     "shear_test": {"2d": _SHEAR, "3d": _SHEAR + ["scene.width=0.015"]},
 }
-#: the profile's PST (a layered slab that cracks, on the profile's weak layer): a 30 cm column, a few steps
-_PROFILE = ["scene.length=0.3", "scene.saw.cut_length=0.1", "time.end=0.0002", "time.frame_interval=0.0001"]
+#: the profile's PST (a layered slab that cracks, on the profile's weak layer): a 50 cm column (longer than its
+#: 39 cm slab, as a PST must be), a few steps
+_PROFILE = ["scene.length=0.5", "scene.saw.cut_length=0.1", "time.end=0.0002", "time.frame_interval=0.0001"]
 _GEOMETRIES["pst_profile"] = {"2d": _PROFILE, "slab": _PROFILE + ["scene.plane_strain='slab'"],
                               "3d": _PROFILE + ["scene.width=0.01"]}
 #: the bonded weak layer's P2G with the yield flags (one PST scene: the three share their kernels)

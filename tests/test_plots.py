@@ -160,3 +160,20 @@ def test_end_to_end_elastic_block(tmp_path):
     np.testing.assert_array_equal(energy["time [s]"], run.times)
     np.testing.assert_array_equal(energy["kinetic_energy [J]"], run.scalars["kinetic_energy"])
     assert energy["kinetic_energy [J]"][-1] > 0                         # the block has been falling
+
+
+def test_pst_fit_faster_than_sound_is_no_speed(tmp_path):
+    """A PST front line faster than the slab's P-wave speed (the front connected to damage ahead) is not a speed:
+    ``front.json`` holds null with the reason, and ``c_max``."""
+    t = np.linspace(0.0, 0.2, 201)
+    front = np.clip(CUT + 400.0 * (t - T0), 0.0, END)           # 400 m/s, faster than c_p 164 m/s
+    with RunWriter(tmp_path / "pst.h5", n_particles=1, particle_fields={"x": ((3,), "float64", "m")},
+                   scalar_series={"front": "m"},
+                   attrs={"scenario": {"name": "pst", "scene": {"kind": "pst", "length": END,
+                                                                "saw": {"cut_length": CUT}}}}) as w:
+        for k, tk in enumerate(t):
+            w.write_frame(tk, k, {"x": np.zeros((1, 3))}, scalars={"front": front[k]})
+    plots.plot_run(tmp_path / "pst.h5", tmp_path)
+    fit = json.loads((tmp_path / "front.json").read_text())
+    assert fit["c_max"] == pytest.approx(164.08, rel=1e-4) and fit["speed"] is None
+    assert fit["speed_null"].startswith("nucleation ahead of the front: the line's 400 m/s exceeds")

@@ -6,8 +6,11 @@ import numpy as np
 import pytest
 
 import mpm_warp as mw
-from mpm_warp.scenes import pst
+from mpm_warp.errors import InvalidArgument
+from mpm_warp.scenes import fronts, pst
+from mpm_warp.scenes.pst import pst_summary
 from mpm_warp.scenes.pst.outcome import SlabCrackDetector, classify, field_line
+from mpm_warp.scenes.snow import Settle
 
 #: a soft, thin slab that breaks over the cut: 12 cm of new snow (120 kg/m^3, E 0.85 MPa, Bergfeld et al. 2023;
 #: tensile strength 1.7 kPa, Sigrist 2006) on a 4 cm weak layer that collapses by a fifth (8 mm, the "about 20 %" of
@@ -106,3 +109,38 @@ def test_a_soft_thin_slab_breaks_over_the_cut(tmp_path):
     d = run.frame(-1)["damage"]
     slab = run.static["group"] == [g["name"] for g in run.attrs["groups"]].index("slab")
     assert (d[slab] >= 0.95).sum() >= 20                     # a crack across the slab's 24 particle rows
+
+
+def test_pst_outcome_needs_the_crack_to_run_beyond_the_saw():
+    BW = 0.02  # m: bin width
+    # a column whose saw cuts into the far end zone (one slab depth, 0.5 m): the saw alone is no END
+    p = pst.PSTParams(length=1.0, dx=0.005, settle=Settle(gravity_ramp=0.05, duration=0.1),
+                  saw=pst.Saw(speed=1.0, cut_length=0.6, cut_from="upslope"), front=pst.Front(bin=BW))
+    s = (np.arange(50) + 0.5) * BW
+    t = np.where(s <= 0.6, 0.1 + s, np.inf)                   # sawn bins only
+    times = np.arange(0.0, 0.9, 0.01)
+    series = {"front": np.array([fronts.front_from_arrival(t, ti, BW) for ti in times])}
+    out = pst_summary(p, p.calibrated(), times, series, s, t, t)
+    assert out["damage_front_final"] == pytest.approx(0.6) and not out["propagated"] and not out["ran_to_end"]
+    cls = classify(p, times, series["front"])
+    assert cls["class"] == "ARR" and math.isnan(cls["end_time"])
+    t3 = np.where(s <= 0.6, 0.1 + s, 0.7 + (s - 0.6) / 30.0)    # the crack runs on from the cut: END
+    series3 = {"front": np.array([fronts.front_from_arrival(t3, ti, BW) for ti in times])}
+    assert classify(p, times, series3["front"])["class"] == "END"
+    assert pst_summary(p, p.calibrated(), times, series3, s, t3, t3)["ran_to_end"]
+
+
+def test_a_column_no_longer_than_its_slab_is_refused_and_a_short_run_has_no_outcome():
+    # the command of issue 37: mpm-warp run pst_demo --set scene.length=0.3 --set scene.saw.cut_length=0.1 ...
+    sets = ["scene.saw.cut_length=0.1", "time.end=0.005"]
+    refused = r"scene.length = 0.3 is invalid: expected a number in \(0.3, inf\) with a saw cut"
+    with pytest.raises(InvalidArgument, match=refused):
+        mw.load_scenario("pst_demo", ["scene.length=0.3", *sets])
+    # just longer than the 0.3 m slab: runs, and 5 ms (before the saw starts at 0.1 s) give no outcome
+    rr = mw.run("pst_demo", overrides=["scene.length=0.45", *sets])
+    r = rr.scene_result
+    assert not r["propagated"] and not r["ran_to_end"] and r["damage_front_final"] == 0.0
+    assert r["outcome"]["class"] is None and r["outcome"]["field_line"] == "PST 10/45 (running) down 30 cm"
+    assert r["outcome"]["note"].startswith("the saw had not started") and math.isnan(r["outcome"]["end_time"])
+    assert r["outcome"]["end_time_null"] == "the crack did not reach the far end zone, having run beyond the cut"
+    assert math.isnan(r["speed"]) and "did not reach 0.15 m" in r["speed_null"]

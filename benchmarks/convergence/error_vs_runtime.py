@@ -39,7 +39,6 @@ The convergence arithmetic (orders, time to an error) is :mod:`mpm_warp.studies.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import statistics
@@ -47,6 +46,7 @@ import sys
 import time
 
 from mpm_warp.errors import SimulationBlowUp
+from mpm_warp.finite_json import dump_finite, load_json
 from mpm_warp.studies.convergence import observed_order, time_to_target
 from mpm_warp.studies.environment import environment
 from mpm_warp.studies.protocol import out_dir, parser
@@ -249,7 +249,7 @@ def main(argv=None) -> int:
     path, stem = os.path.join(folder, name + ".json"), os.path.join(folder, name)
     if a.plot_only:
         with open(path) as fh:
-            data = json.load(fh)
+            data = load_json(fh)
         plot(data, stem + ".png")
         with open(stem + ".md", "w") as fh:
             fh.write(markdown(data))
@@ -280,7 +280,7 @@ def main(argv=None) -> int:
             p["summary"] = summarise(name, p["dx_ladder"], p["dt_ladder"])
             data["wall_time_benchmark_s"] = time.perf_counter() - t_all
             with open(path + ".tmp", "w") as fh:
-                json.dump(data, fh, indent=1, default=float)
+                dump_finite(data, fh, indent=1, default=float)
             os.replace(path + ".tmp", path)
         s = p["summary"]
         print(f"{name}: order in dx {_f(s['observed_order_dx'])}, time to 1 %: {s['time_to_1pct']}", flush=True)

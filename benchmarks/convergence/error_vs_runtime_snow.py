@@ -57,6 +57,7 @@ import numpy as np
 
 import mpm_warp as mw
 from mpm_warp.errors import InvalidArgument
+from mpm_warp.finite_json import load_json
 from mpm_warp.memory import estimate_memory
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.studies.convergence import ladder_summary
@@ -266,7 +267,7 @@ def load(results: str, name: str = OUT) -> dict:
     path = os.path.join(results, name + ".json")
     if os.path.isfile(path):
         with open(path) as fh:
-            return json.load(fh)
+            return load_json(fh)
     return {"ladders": {"pst": [], "shear": []}, "summary": {}}
 
 

@@ -43,7 +43,6 @@ recomputes the summary and redraws from the JSON.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import sys
@@ -53,6 +52,7 @@ import numpy as np
 
 import mpm_warp as mw
 from mpm_warp.camclay_forms import oedometric_ratio
+from mpm_warp.finite_json import dump_finite, load_json
 from mpm_warp.materials import hardening_collapse
 from mpm_warp.studies.convergence import observed_order
 from mpm_warp.studies.environment import environment
@@ -201,7 +201,7 @@ def main(argv=None) -> int:
     path, png = os.path.join(folder, name + ".json"), os.path.join(folder, name + ".png")
     if a.plot_only:
         with open(path) as fh:
-            data = json.load(fh)
+            data = load_json(fh)
         data["summary"] = summarise(data["runs"])
         _write(path, data)
         plot(data, png)
@@ -247,7 +247,7 @@ def main(argv=None) -> int:
 def _write(path: str, data: dict) -> None:
     """The JSON through a temporary file (a kill leaves the previous one)."""
     with open(path + ".tmp", "w") as fh:
-        json.dump(data, fh, indent=1)
+        dump_finite(data, fh, indent=1)
     os.replace(path + ".tmp", path)
 
 

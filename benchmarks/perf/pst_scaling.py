@@ -19,13 +19,13 @@ Usage::
 
 from __future__ import annotations
 
-import json
 import os
 import statistics
 import sys
 import time
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes import attach
 from mpm_warp.studies.blocks import block_scenario
 from mpm_warp.studies.environment import environment, write_json
@@ -171,7 +171,7 @@ def main(argv=None) -> int:
     data = {"benchmark": __doc__.splitlines()[0], "runs": {}}
     if os.path.exists(path):
         with open(path) as fh:
-            data = json.load(fh)
+            data = load_json(fh)
     data["runs"][a.label] = entry
     print(write_json(name, data, folder))
     return 0

@@ -23,7 +23,6 @@ keeps what it measured, and ``<name>.png`` (particle-steps per second against pa
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
@@ -31,6 +30,7 @@ import time
 import warp_block
 from taichi_peer import run_taichi_block_subprocess
 
+from mpm_warp.finite_json import load_json
 from mpm_warp.studies import plastic_block as pb
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -159,7 +159,7 @@ def main(argv=None) -> int:
         folder = a.out or RESULTS
         name = a.name or f"throughput_{'cuda' if a.device.startswith('cuda') else 'cpu'}"
         with open(os.path.join(folder, name + ".json")) as fh:
-            figure(json.load(fh), os.path.join(folder, name + ".png"))
+            figure(load_json(fh), os.path.join(folder, name + ".png"))
         return 0
     if a.quick:
         a.particles, a.steps, a.repeats, a.threads = [4096.0], 5, 1, [1]

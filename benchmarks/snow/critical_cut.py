@@ -28,13 +28,13 @@ Usage::
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import sys
 import time
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.pst.static import weac_answer
 from mpm_warp.scenes.weak_layer import stored_calibration
@@ -78,7 +78,7 @@ def load(folder: str) -> dict:
     path = os.path.join(folder, OUT + ".json")
     if os.path.isfile(path):
         with open(path) as fh:
-            data = json.load(fh)
+            data = load_json(fh)
         if isinstance(data.get("cases"), dict):
             return data
     return {"cases": {}}
@@ -90,7 +90,7 @@ def ladder_rows() -> dict:
     if not os.path.isfile(path):
         return {}
     with open(path) as fh:
-        levels = json.load(fh)["ladders"]["pst"]
+        levels = load_json(fh)["ladders"]["pst"]
     out = {}
     for lv in levels:
         if lv["precision"] == "float32" and lv.get("bracketed"):
@@ -165,7 +165,7 @@ def reference(name: str, data: dict) -> float | None:
     if not os.path.isfile(path):
         return None
     with open(path) as fh:
-        levels = json.load(fh)["ladders"]["pst"]
+        levels = load_json(fh)["ladders"]["pst"]
     hit = [lv for lv in levels if lv.get("level") == 1 and lv["precision"] == "float32"]
     return hit[0]["critical_cut"] if hit else None
 

@@ -20,7 +20,6 @@ Usage::
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
@@ -28,6 +27,7 @@ import time
 import numpy as np
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.shear_test import shear_curves
 from mpm_warp.studies import interface_model1d
@@ -186,7 +186,7 @@ def main(argv=None) -> int:
     old = os.path.join(folder, name + ".json")
     if os.path.exists(old):  # parts run apart: keep the others
         with open(old) as f:
-            data = {**json.load(f), **data}
+            data = {**load_json(f), **data}
     run = {"column": lambda: column_part(cells, a.device), "model1d": lambda: model1d_part(cells),
            "free": lambda: free_part(a.device), "shear": lambda: shear_part(SHEAR_CELLS, a.device),
            "cost": lambda: cost_part(a.device), "ladder": lambda: ladder_part(a.device),

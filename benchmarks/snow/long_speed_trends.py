@@ -28,13 +28,13 @@ Usage::
 from __future__ import annotations
 
 import datetime
-import json
 import os
 import sys
 import time
 
 import numpy as np
 
+from mpm_warp.finite_json import load_json
 from mpm_warp.studies.convergence import loglog_slope
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.fanout import dask_map
@@ -58,7 +58,7 @@ def one_case(param: str, value: float, cut: float, device: str, column: list, fo
     path = os.path.join(folder, f"{param}_{value:.6g}.json")
     if os.path.exists(path):
         with open(path) as fh:
-            row = json.load(fh)
+            row = load_json(fh)
         finished = datetime.datetime.fromtimestamp(os.path.getmtime(path), datetime.timezone.utc)
         return {**row, "from_earlier_run": True, "finished_at": row.get("finished_at") or finished.isoformat()}
     sc = mw.load_scenario("pst_flat", column + [f"scene.{param}={value!r}"])
@@ -184,7 +184,7 @@ def main(argv=None) -> int:
     folder = out_dir(a, RESULTS, "long_speed_trends")
     if a.figure_only:
         with open(os.path.join(folder, name + ".json")) as fh:
-            figure(json.load(fh), os.path.join(folder, name + ".png"))
+            figure(load_json(fh), os.path.join(folder, name + ".png"))
         return 0
     from mpm_warp.scenes.references import weac_collapse_height
 

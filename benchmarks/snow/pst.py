@@ -16,10 +16,17 @@ Usage (a long run on the CPU; the run file goes to ``--h5dir``, not to the repos
 
     nohup .venv/bin/python benchmarks/snow/pst.py pst_flat --h5dir /tmp/snow > flat.log 2>&1 &
     .venv/bin/python benchmarks/snow/pst.py --quick     # a small PST, results to a temporary folder
+    .venv/bin/python benchmarks/snow/pst.py pst_slope --reanalyse   # no run: see below
+
+``--reanalyse`` re-derives the speed analysis of the committed ``snow_<name>.json`` from the front paths it
+stores (:func:`mpm_warp.scenes.pst.analysis.rederive_speeds`), with today's code, and rewrites it and its
+figure; the run's own record (environment, wall time, series) stays, and ``reanalysis`` says what was redone.
 """
 
 from __future__ import annotations
 
+import datetime
+import json
 import math
 import os
 import sys
@@ -28,14 +35,18 @@ import time
 import numpy as np
 
 import mpm_warp as mw
+from mpm_warp.scenes.front_speed import NUCLEATION
+from mpm_warp.scenes.pst.analysis import rederive_speeds
 from mpm_warp.scenes.weak_layer import stored_calibration
-from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.environment import environment, git_commit, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import FIELD_SPEED, ladder_pst
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 #: --quick: the ladder PST at 6 cells across its layer (dx 1 cm) on a 1.5 m column, sawn to 0.5 m, to 0.6 s
 QUICK = ladder_pst(0.01) + ["scene.length=1.5", "scene.saw.cut_length=0.5", "time.end=0.6"]
+#: why a frame's touchdown is null in the results file
+TOUCHDOWN_NULL = "null before the deflection front ran 4 bins beyond the cut (no touchdown yet)"
 
 
 def _plt():
@@ -66,6 +77,33 @@ def deflection_profiles(run, params, times) -> list[dict]:
     return out
 
 
+def _nan(values) -> list[float]:
+    """A results file's list with its nulls as nan (for plotting)."""
+    return [math.nan if v is None else float(v) for v in values]
+
+
+def reanalyse(name: str, folder: str) -> str:
+    """Re-derive the speeds of ``RESULTS/snow_<name>.json`` from its stored paths; write it and its figure to
+    ``folder``; return the JSON's path (module docstring)."""
+    with open(os.path.join(RESULTS, f"snow_{name}.json")) as fh:
+        res = json.load(fh)
+    sc = mw.load_scenario(res["scenario"], res["overrides"])
+    r, p = res["result"], sc.scene
+    stored = (r["cut_length"], r["column_length"], r["shear_wave_speed"])
+    today = (float(p.saw.cut_length), float(p.length), p.equivalent_slab().material().s_wave_speed)
+    if not all(math.isclose(a, b, rel_tol=1e-9) for a, b in zip(stored, today, strict=True)):
+        raise SystemExit(f"{name}: the scenario today ({today}) is not the one run ({stored}): rerun it")
+    res["result"] = rederive_speeds(p, r)
+    res["series"]["touchdown_null"] = TOUCHDOWN_NULL
+    res["reanalysis"] = {"commit": git_commit(), "date": datetime.datetime.now(datetime.timezone.utc).isoformat(
+        timespec="seconds"), "command": f"python benchmarks/snow/pst.py {name} --reanalyse",
+        "note": "the speeds (profiles, means, largest, jumps) re-derived from the stored front paths; the run "
+                "itself is the environment's commit"}
+    path = write_json(f"snow_{name}", res, folder, end_load=False)
+    figure(res, res["deflection_profiles"], os.path.join(folder, f"snow_{name}.png"))
+    return path
+
+
 def figure(res: dict, profiles: list[dict], path: str) -> None:
     """Fronts against time, speed profiles, deflection profiles (module docstring)."""
     plt = _plt()
@@ -80,7 +118,10 @@ def figure(res: dict, profiles: list[dict], path: str) -> None:
     for key, style, color, label in (("damage", "o-", "C3", "damage front"),
                                      ("deflection", "s--", "C0", "deflection front")):
         prof = r[f"{key}_speed_profile"]
-        ax[1].plot(prof["s"], prof["speed"], style, color=color, ms=3, label=label)
+        ax[1].plot(prof["s"], _nan(prof["speed"]), style, color=color, ms=3, label=label)
+        for k, j in enumerate(r.get(f"{key}_jumps") or []):
+            ax[1].axvspan(j["start"], j["end"], color=color, alpha=0.15, zorder=0,
+                          label=f"{key}: {NUCLEATION} (no speed)" if k == 0 else None)
     ax[1].axhspan(*FIELD_SPEED, color="0.85", label="field 20-30 m/s")
     ax[1].axhline(r["heierli_speed_run"], color="C2", ls="-.",
                   label=f"Heierli, run's h_c: {r['heierli_speed_run']:.3g} m/s")
@@ -92,7 +133,7 @@ def figure(res: dict, profiles: list[dict], path: str) -> None:
     top = 1.1 * r["shear_wave_speed"]
     for key in ("damage", "deflection"):
         prof = r[f"{key}_speed_profile"]
-        inside = [v for x, v in zip(prof["s"], prof["speed"], strict=True) if x <= s_max and math.isfinite(v)]
+        inside = [v for x, v in zip(prof["s"], _nan(prof["speed"]), strict=True) if x <= s_max and math.isfinite(v)]
         if inside:
             top = max(top, min(1.05 * max(inside), 2.0 * r["shear_wave_speed"]))
     ax[1].axvspan(s_max, r["column_length"], color="0.93", zorder=0, label="end zone (one slab thickness)")
@@ -124,7 +165,14 @@ def main(argv=None) -> int:
                     help="continue an interrupted run of this scene in --h5dir from its checkpoint")
     ap.add_argument("--prior-wall-s", type=float, default=0.0,
                     help="with --resume: wall seconds the interrupted part ran (added to the reported wall time)")
+    ap.add_argument("--reanalyse", action="store_true",
+                    help="no run: re-derive the speeds of the committed snow_<name>.json from its stored front paths")
     a = ap.parse_args(argv)
+    if a.reanalyse:
+        if a.scene is None:
+            ap.error("--reanalyse needs the scene (pst_flat, pst_slope)")
+        print("wrote", reanalyse(a.name or os.path.splitext(os.path.basename(a.scene))[0], out_dir(a, RESULTS, "pst")))
+        return 0
     if a.quick:
         a.scene, a.overrides = a.scene or "pst_flat", QUICK + a.overrides
     if a.scene is None:
@@ -151,6 +199,7 @@ def main(argv=None) -> int:
            "weak_layer": stored_calibration(sc).to_dict(),
            "result": rr.scene_result, "times": list(mon.times),
            "series": {k: list(mon.series[k]) for k in keep}}
+    res["series"]["touchdown_null"] = TOUCHDOWN_NULL
     r = rr.scene_result
     # deflection profiles while the crack runs: when the deflection front is at 1/4, 1/2 and 3/4 of its run
     df = np.asarray(mon.series["deflection_front"])

@@ -26,12 +26,12 @@ Usage::
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 import sys
 import time
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.post.pst_picture import pst_picture
 from mpm_warp.scenes.pst.static import static_column
 from mpm_warp.scenes.snowpack import SnowLayer
@@ -124,7 +124,7 @@ def main(argv=None) -> int:
     old = os.path.join(folder, OUT + ".json")
     if os.path.isfile(old) and not a.quick:
         with open(old) as fh:
-            data = json.load(fh)
+            data = load_json(fh)
     for name in names:
         data["cases"][name] = run_case(name, folder, a.device)
         print("wrote", write_json(OUT, data, folder), flush=True)

@@ -25,13 +25,13 @@ Usage::
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import os
 import sys
 import time
 
 import mpm_warp as mw
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.snowpack import SnowLayer
 from mpm_warp.studies.environment import environment, write_json
@@ -130,7 +130,7 @@ def load(folder: str) -> dict:
     path = os.path.join(folder, OUT + ".json")
     if os.path.isfile(path):
         with open(path) as fh:
-            return json.load(fh)
+            return load_json(fh)
     return {"cases": {}}
 
 

@@ -28,13 +28,13 @@ Usage::
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
 
 import numpy as np
 
+from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.convergence import loglog_slope
 from mpm_warp.studies.environment import environment, write_json
@@ -124,7 +124,7 @@ def main(argv=None) -> int:
     if a.figure_only:
         folder = a.out or RESULTS
         with open(os.path.join(folder, name + ".json")) as fh:
-            figure(json.load(fh), os.path.join(folder, name + ".png"))
+            figure(load_json(fh), os.path.join(folder, name + ".png"))
         return 0
     slab_e, h_c_factors = ((2.5e6, 5.0e6), (1.0, 2.0)) if a.quick else (SLAB_E, H_C_FACTORS)
     from mpm_warp.scenes.references import weac_collapse_height

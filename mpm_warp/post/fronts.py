@@ -12,9 +12,10 @@ import numpy as np
 from ..errors import InvalidArgument, MPMError
 from ..io import RunData
 from ..loader import scene_params_from_dict
+from ..scenes.front_speed import NUCLEATION
 from ..scenes.fronts import fit_window, steady_speed
 from ..scenes.pst import PSTParams
-from ..scenes.pst.analysis import MEAN_SPEED_DISTANCE, end_zone
+from ..scenes.pst.analysis import MEAN_SPEED_DISTANCE, end_zone, slab_p_wave_speed
 from ..scenes.weak_layer import CalibratedWeakLayer
 
 __all__ = ["scene_params", "scene_calibration", "front_name", "fit_front_speed", "front_speed", "front_and_saw_x",
@@ -94,7 +95,11 @@ def fit_front_speed(times, front, lo: float = 0.2, hi: float = 0.9, start: float
 
 
 def front_speed(run: RunData) -> dict:
-    """:func:`fit_front_speed` of the run's front series, with a PST's window for a PST (see module docstring)."""
+    """:func:`fit_front_speed` of the run's front series, with a PST's window for a PST (see module docstring).
+
+    For a PST, ``c_max`` is the slab's P-wave speed (m/s): a line faster than it, or no line, gives ``speed`` nan
+    with the reason under ``speed_null`` (a front faster than sound connected to damage ahead of it).
+    """
     name = front_name(run)
     if name is None:
         raise InvalidArgument("run", run.path, "a run with a front series (front_position or a PST's front)")
@@ -103,7 +108,14 @@ def front_speed(run: RunData) -> dict:
     if name == "front" and isinstance(params, PSTParams):
         start = float(params.saw.cut_length) + params.bin_width      # beyond the cut: the saw's own path left out
         end = min(start - params.bin_width + MEAN_SPEED_DISTANCE, float(params.length) - end_zone(params))
-        return fit_front_speed(t, xf, 0.0, 1.0, start=start, end=max(end, start + params.bin_width))
+        fit = fit_front_speed(t, xf, 0.0, 1.0, start=start, end=max(end, start + params.bin_width))
+        fit["c_max"] = slab_p_wave_speed(params)
+        if not fit["speed"] <= fit["c_max"]:         # faster than sound (or none): not a speed
+            fit["speed_null"] = (f"{NUCLEATION}: the line's {fit['speed']:.4g} m/s exceeds the slab's c_p "
+                                 f"{fit['c_max']:.4g} m/s" if fit["speed"] > fit["c_max"] else
+                                 "fewer than 3 distinct front positions in the window: the front did not run")
+            fit["speed"] = float("nan")
+        return fit
     return fit_front_speed(t, xf)
 
 

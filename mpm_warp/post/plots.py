@@ -18,12 +18,12 @@ caller's matplotlib backend is left alone.
 from __future__ import annotations
 
 import csv
-import json
 import os
 import re
 
 import numpy as np
 
+from ..finite_json import dump_finite
 from ..io import RunData, read_run
 from ..scenes.pst import PSTParams
 from .fronts import front_name, front_speed, scene_params
@@ -68,7 +68,7 @@ def _save(fig, out_dir: str, name: str, columns: dict, fit: dict | None = None) 
     files = [png, _write_csv(os.path.join(out_dir, name + ".csv"), columns)]
     if fit is not None:
         with open(os.path.join(out_dir, name + ".json"), "w") as f:
-            json.dump(fit, f, indent=1)
+            dump_finite(fit, f, indent=1)
         files.append(os.path.join(out_dir, name + ".json"))
     return files
 

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import datetime
 import importlib.metadata
-import json
 import os
 import platform
 import subprocess
 
 import warp as wp
 
+from ..finite_json import dump_finite
 from ..result import versions
 
 __all__ = ["environment", "git_commit", "write_json"]
@@ -62,18 +62,20 @@ def _version_str(v) -> str | None:
     return ".".join(str(p) for p in v) if v else None
 
 
-def write_json(name: str, data: dict, results_dir: str) -> str:
+def write_json(name: str, data: dict, results_dir: str, end_load: bool = True) -> str:
     """Write ``<results_dir>/<name>.json`` (through a temporary file, so a kill leaves the old one); return its path.
 
     When ``data`` has an ``environment`` the load average at writing time is added beside the one at
-    the start (how busy the shared machine was).
+    the start (how busy the shared machine was), unless ``end_load`` is False (a result re-derived from a
+    stored run keeps its run's record). No inf or NaN is written: a non-finite number becomes null
+    with its reason under ``<key>_null`` (:func:`~mpm_warp.finite_json.finite_json`).
     """
-    if isinstance(data.get("environment"), dict):
+    if end_load and isinstance(data.get("environment"), dict):
         data["environment"]["load_average_at_end_1_5_15_min"] = list(os.getloadavg())
     os.makedirs(results_dir, exist_ok=True)
     path = os.path.join(results_dir, name + ".json")
     with open(path + ".tmp", "w") as fh:
-        json.dump(data, fh, indent=1, default=float)
+        dump_finite(data, fh, indent=1, default=float)
         fh.write("\n")
     os.replace(path + ".tmp", path)
     return path

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .analysis import end_zone
+from .analysis import crack_ran, end_zone
 from .params import PSTParams
 
 __all__ = ["SlabCrackDetector", "classify", "field_line", "THROUGH_DAMAGE", "THROUGH_COVER", "STALL_TIME"]
@@ -110,13 +110,13 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
         ``field_line`` (:func:`field_line`), ``cut``, ``column_length``, ``depth`` (m, vertical: the slab's
         bed-normal thickness over the cosine of the slope), ``end_time``,
         ``slab_fracture_time`` (s, nan: never), ``slab_fracture_at`` (m from the cut end, nan), ``arrest_at``
-        (m from the cut end for ARR, nan otherwise), ``note``.
+        (m from the cut end for ARR, nan otherwise), ``note``; a nan value has its reason under ``<key>_null``.
     """
     t = np.asarray(times, dtype=float)
     fr = np.asarray(front, dtype=float)
     L, D = float(params.length), float(params.slab_depth) / math.cos(math.radians(params.slope_angle))
     cut = float(params.saw.cut_length) if saw_cut is None or not math.isfinite(saw_cut) else float(saw_cut)
-    reach_end = np.nonzero(fr >= L - end_zone(params))[0]
+    reach_end = np.nonzero((fr >= L - end_zone(params)) & crack_ran(params, fr))[0]
     t_end = float(t[reach_end[0]]) if len(reach_end) else math.nan
     sc = np.full(len(t), np.nan) if slab_crack is None else np.asarray(slab_crack, dtype=float)
     broke = np.nonzero(np.isfinite(sc))[0]
@@ -138,10 +138,20 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
             out["note"] = f"the crack ran {fr[-1] - float(params.saw.cut_length):.2f} m beyond the saw and stopped"
     else:
         cls = None
-        out["note"] = "the crack was still running when the run ended (lengthen time.end to classify it)"
+        out["note"] = ("the saw had not started when the run ended" if not len(t) or t[-1] < params.saw_start else
+                       "the crack was still running when the run ended") + " (lengthen time.end to classify it)"
     out["class"] = cls
     out["field_line"] = field_line(cls, cut, L, D)
+    for key, why in _NAN_REASONS.items():
+        if not math.isfinite(out[key]):
+            out[f"{key}_null"] = why
     return out
+
+
+#: why a value of :func:`classify` is nan (null in a results file)
+_NAN_REASONS = {"end_time": "the crack did not reach the far end zone, having run beyond the cut",
+                "slab_fracture_time": "the slab did not crack through", "slab_fracture_at": "not an SF outcome",
+                "arrest_at": "not an ARR outcome"}
 
 
 def _stalled(t, front, params: PSTParams) -> bool:

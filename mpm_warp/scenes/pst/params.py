@@ -201,6 +201,10 @@ class PSTParams:
         finite_number(f"{where}.front.bin", self.front.bin, lo=0.0)
         finite_number(f"{where}.front.deflection", self.front.deflection, lo=0.0, lo_open=True, hi=1.0)
         finite_number(f"{where}.front.runaway_lead", self.front.runaway_lead, lo=0.0, lo_open=True)
+        zone = max(self.slab_depth, 2.0 * self.bin_width)   # analysis.end_zone: the free end unloads the layer
+        if self.saw.cut_length > 0 and not L > zone:         # (uncut, the scene is a column: interface_column)
+            raise InvalidArgument(f"{where}.length", self.length, f"a number in ({zone:g}, inf) with a saw cut: longer "
+                                  "than the far end zone, one slab depth, where a front counts as at the far end")
         return self
 
     def _check_layers(self, part: str, where: str) -> None:

@@ -8,13 +8,13 @@ line for a file that does not exist yet.
 
 from __future__ import annotations
 
-import json
 import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from ...errors import InvalidArgument
+from ...finite_json import load_json
 from .fmt import environment_of
 
 __all__ = ["PARTS", "Section", "Context", "SECTIONS", "section", "pending", "document", "slug"]
@@ -106,7 +106,7 @@ class Context:
             p = self.path(source)
             if os.path.isfile(p):
                 with open(p) as fh:
-                    self._cache[source] = json.load(fh)
+                    self._cache[source] = load_json(fh)
             else:
                 self._cache[source] = None
         return self._cache[source]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from ...scenes.front_speed import NUCLEATION
 from ...scenes.pst.analysis import SPEED_LIMIT_DISTANCE, SPEED_WINDOW
 from .. import snow as refs
 from ..snow import DEM_STEADY_MAX, FIELD_CUT, FIELD_SPEED, LADDER_PST, LONG_PST_SPEED, STEADY_FROM
@@ -74,6 +75,39 @@ def _profile_text(res: dict, prefix: str) -> str:
             + (f" ({v1 / cs:.2f} c_s)" if finite(cs) else ""))
 
 
+def _jumps_text(res: dict) -> str:
+    """The stretches each front crossed faster than c_p (``{prefix}_jumps``): where, how fast, from when."""
+    parts = []
+    for prefix in ("damage", "deflection"):
+        jumps = res.get(f"{prefix}_jumps")
+        if jumps is None:
+            continue
+        text = "; ".join(f"{j['start']:.2f}-{j['end']:.2f} m in {1e3 * j['crossed_in']:.2f} ms from "
+                         f"{j['time']:.4f} s" for j in jumps)
+        parts.append(f"{prefix} front: {text or 'none'}")
+    return ". ".join(parts) if parts else DASH
+
+
+def _nucleation_note(res: dict) -> str:
+    """What a front did where it crossed a stretch faster than c_p (the first and last stretch of each)."""
+    text = ["A front crossing a stretch faster than the slab's P-wave speed did not travel there: the layer (or the "
+            "slab base) ahead had failed (or come down) before it, and the window speeds over that stretch are "
+            f"left out (`{NUCLEATION}` in the profile's `status`)."]
+    lead, at = res.get("max_damage_lead"), res.get("max_damage_lead_at")
+    if finite(lead) and lead > 0 and finite(at):
+        text.append(f"In the run's own damage times the largest lead is at {at:.2f} m: damaged while the "
+                    f"contiguous damage front was {lead:.2f} m behind it.")
+    for prefix in ("damage", "deflection"):
+        jumps = res.get(f"{prefix}_jumps") or []
+        if jumps:
+            j = jumps[-1]
+            text.append(f"The {prefix} front reached {j['start']:.2f} m at {j['time']:.4f} s and {j['end']:.2f} m "
+                        f"{1e3 * j['crossed_in']:.2f} ms later (apparently {j['extent'] / j['crossed_in']:.0f} m/s)."
+                        if j["crossed_in"] > 0 else f"The {prefix} front reached {j['start']:.2f}-{j['end']:.2f} m "
+                        f"at once at {j['time']:.4f} s.")
+    return " ".join(text)
+
+
 def render_pst(data: dict, ctx) -> list[str]:
     r, wl = data["result"], data["weak_layer"]
     given = wl.get("given") or {}
@@ -104,6 +138,8 @@ def render_pst(data: dict, ctx) -> list[str]:
          f"calibrated h_c {fx(r.get('collapse_height_calibrated'), 2, 1e3)} mm"],
         ["damage ahead of the contiguous front", "none" if lead == 0 else
          f"{fx(lead, 2)} m, at {fx(r.get('max_damage_lead_at'), 2)} m", ""],
+        [f"{NUCLEATION} (stretches the front crossed faster than c_p; no speed there)", _jumps_text(r),
+         f"c_p {fx(r.get('p_wave_speed'), 1)} m/s (the slab)"],
         ["damage front's reach", f"{fx(r.get('damage_front_final'), 2)} m of {fx(r.get('column_length'), 1)} m"
          + (" (into the far end zone)" if r.get("ran_to_end") else ""), ""],
     ]
@@ -113,6 +149,8 @@ def render_pst(data: dict, ctx) -> list[str]:
            f"kappa_s {fx(wl.get('kappa_s'), 1)} J/m^3, xi {fx(wl.get('xi'), 4)} (delta_s "
            f"{fx(wl.get('delta_s'), 2, 1e3)} mm, h_c {fx(wl.get('h_c'), 2, 1e3)} mm).", ""]
     out += table(["quantity", f"`{data['name']}`", "reference"], rows, ["l", "l", "l"])
+    if r.get("damage_jumps") or r.get("deflection_jumps"):
+        out += ["", _nucleation_note(r)]
     out += ["", env_note(data)]
     if data.get("resume_note"):
         out += ["", f"Resumed: {data['resume_note']}."]
