@@ -20,7 +20,8 @@ from .fmt import environment_of
 __all__ = ["PARTS", "Section", "Context", "SECTIONS", "section", "pending", "document", "slug"]
 
 #: The parts of the document, in order: key -> heading.
-PARTS = {"perf": "Performance", "convergence": "Convergence", "snow": "Snow science", "robustness": "Robustness"}
+PARTS = {"perf": "Performance", "convergence": "Convergence", "snow": "Snow science", "field": "Field data",
+         "robustness": "Robustness"}
 
 DOC = "docs/results.md"
 
