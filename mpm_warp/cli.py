@@ -1,4 +1,4 @@
-"""Command line: ``mpm-warp run|resume|scenes|info|render|plot|sweep ...`` (every subcommand is here).
+"""Command line: ``mpm-warp run|resume|scenes|info|render|plot|profile|sweep|field ...`` (``field``: .cli_field).
 
 Errors the library raises on purpose (bad input, blow-ups) are printed as one
 clear line with exit status 2 (input, files) or 3 (simulation), never a traceback;
@@ -347,13 +347,17 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("run", help="HDF5 run file")
     pl.add_argument("--out", default=None, help="output folder (default: RUN_plots beside the run)")
     pl.set_defaults(func=cmd_plot)
-    pr = sub.add_parser("profile", help="read a CAAML snow profile: its layers, densities and PST results")
+    pr = sub.add_parser("profile", help="read a CAAML snow profile: its layers, densities, and each PST as a column "
+                                   "or the reason it cannot be one")
     pr.add_argument("file", help="a CAAML 5 or 6 XML snow profile")
     pr.add_argument("--no-calibration", action="store_true",
                     help="set up each PST's column without calibrating its weak layer (faster; a column the "
                          "calibration would refuse is then not found)")
     pr.set_defaults(func=cmd_profile)
     _add_sweep(sub)
+    from .cli_field import add_field
+
+    add_field(sub)
     return p
 
 

@@ -30,7 +30,8 @@ def test_the_example_profile_gives_the_pst_its_snowpack():
     (sub,) = p.substratum_stack()
     assert sub.thickness == pytest.approx(0.15) and sub.density == pytest.approx(300.0)
     assert len(p.profile.sha256) == 64
-    assert p.profile.weak_layer.startswith("slab 48 cm (2 layers), weak layer 2 cm (the profile layer's own (SH, 2 cm))")
+    assert p.profile.weak_layer.startswith("slab 48 cm (2 layers), weak layer 2 cm (the profile layer's own "
+                                           "(SH, 2 cm))")
     assert p.profile.weak_layer.endswith("in layer 2 (depth 0.48-0.5 m): SH F")
     # the layers load the weak layer: sum rho g h cos(slope)
     assert p.sigma_n == pytest.approx(9.81 * COS35 * COS35 * (81.0 * 0.10 + 230.0 * 0.38), rel=1e-9)

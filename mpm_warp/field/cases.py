@@ -66,7 +66,8 @@ class FieldCase:
     def line(self) -> str:
         """``pit: PST 38/100 (End) down 80 cm: slab ..., weak layer ..., w_f ...``."""
         wf = self.fracture_energy
-        w = (f"w_f {wf.value:.3g} J/m^2 (weac's G at the recorded cut)" if wf.value is not None else
+        how = "given" if wf.reason == "given" else "weac's G at the recorded cut"
+        w = (f"w_f {wf.value:.3g} J/m^2 ({how})" if wf.value is not None else
              f"w_f {self.params.weak_layer.w_f:g} J/m^2, the default: {wf.reason}")
         return f"{self.pit}: {self.test}: {describe(self.column)}; {w}"
 
@@ -124,7 +125,7 @@ def _params(profile: SnowProfileData, rec: PSTRecord, col: ProfileColumn, base: 
 
 
 def field_case(profile: SnowProfileData, rec: PSTRecord, *, base: PSTParams | None = None,
-               calibrate: bool = True) -> FieldCase | FieldRefusal:
+               calibrate: bool = True, w_f: float | None = None) -> FieldCase | FieldRefusal:
     """The record ``rec`` of ``profile`` as a column, or why not (module docstring).
 
     Parameters
@@ -138,13 +139,15 @@ def field_case(profile: SnowProfileData, rec: PSTRecord, *, base: PSTParams | No
     calibrate : bool
         Calibrate the weak layer under this slab (as building the scene does): a column the calibration refuses
         is refused here.
+    w_f : float, optional
+        The weak layer's fracture energy (J/m^2) when known (a table gives it); else read back from the cut.
     """
     pit = os.path.basename(profile.source)
     why = _triage(rec, profile)
     if why is not None:
         return _refuse(pit, rec, *why)
     try:
-        col = profile_column(profile, rec.depth)
+        col = profile_column(profile, rec.depth, rec.layer_thickness)
     except ProfileError as e:
         msg = str(e)
         kind = ("failure depth" if msg.startswith("the failure depth") else
@@ -154,7 +157,8 @@ def field_case(profile: SnowProfileData, rec: PSTRecord, *, base: PSTParams | No
     params, notes = None, list(col.notes)
     try:
         params = _params(profile, rec, col, base).validate("scene")
-        wf = implied_fracture_energy(params, rec.cut_length)
+        wf = (implied_fracture_energy(params, rec.cut_length) if w_f is None else
+              ImpliedFractureEnergy(float(w_f), None, None, None, "given"))
         if wf.value is not None:
             params = dataclasses.replace(params, weak_layer=dataclasses.replace(params.weak_layer, w_f=wf.value))
         params = _carries_its_slab(params, notes)
@@ -172,16 +176,17 @@ def _carries_its_slab(params: PSTParams, notes: list[str]) -> PSTParams:
     before any cut, which the observer did not see. Its strength is then raised to :data:`STRENGTH_MARGIN` times
     the least at which it carries the slab and fails in shear (the least the observation allows), and noted.
     """
-    from ..scenes.weak_layer.calibration import least_shear_strength
+    from ..scenes.weak_layer.calibration import carries_slab, least_shear_strength
 
     wl = params.weak_layer
-    if not wl.tau_p > 0.0:
+    layer = {"E": wl.E, "nu": wl.nu, "density": wl.density, "D_wl": params.weak_layer_thickness, "M": wl.M,
+             "beta": wl.beta, "sigma_n": params.sigma_n, "h_c": wl.h_c or None, "p0_int_ini": wl.p0_int_ini,
+             "p0_floor_ratio": wl.p0_floor_ratio}
+    if not wl.tau_p > 0.0 or carries_slab(wl.tau_p, **layer):
         return params
-    least = least_shear_strength(E=wl.E, nu=wl.nu, density=wl.density, D_wl=params.weak_layer_thickness, M=wl.M,
-                                 beta=wl.beta, sigma_n=params.sigma_n, h_c=wl.h_c or None, p0_int_ini=wl.p0_int_ini,
-                                 p0_floor_ratio=wl.p0_floor_ratio)
-    if least is None or least <= wl.tau_p:
-        return params
+    least = least_shear_strength(wl.tau_p, **layer)
+    if least is None:
+        return params               # no strength carries it: the calibration refuses the column, in field terms
     tau = math.ceil(STRENGTH_MARGIN * least / 10.0) * 10.0
     notes.append(f"weak layer's shear strength {tau:.0f} Pa, not the default {wl.tau_p:.0f} Pa: under "
                  f"{params.sigma_n:.0f} Pa the default would be crushed by the slab the pit showed it carrying; "

@@ -29,7 +29,7 @@ from .paths import (
 from .record import CalibratedWeakLayer
 
 __all__ = ["CalibratedWeakLayer", "stored_calibration", "weak_layer_material", "weac_collapse_height",
-           "heierli_anticrack", "shear_range", "CALIBRATION_RTOL", "least_shear_strength"]
+           "heierli_anticrack", "shear_range", "CALIBRATION_RTOL", "least_shear_strength", "carries_slab"]
 
 
 def heierli_anticrack(slab_E: float, slab_thickness: float, slab_density: float, h_c: float) -> tuple[float, float]:
@@ -197,29 +197,34 @@ def _closed_forms(given: dict, *, E, nu, density, D_wl, M, beta, sigma_n, h_c, x
     return mat0, xi, p_bond, tau_first, sigma_c
 
 
-def least_shear_strength(*, E: float, nu: float, density: float, D_wl: float, M: float, beta: float,
-                         sigma_n: float, h_c: float | None = None, p0_int_ini: float = 0.0,
-                         p0_floor_ratio: float = 1e-5, tau_max: float = 1.0e5) -> float | None:
-    """The least shear strength ``tau_p`` (Pa) at which a layer (as :func:`weak_layer_material`) under ``sigma_n``
-    (Pa) carries the slab and fails in shear, to 0.1 %; None when none up to ``tau_max`` does.
+def carries_slab(tau_p: float, *, E: float, nu: float, density: float, D_wl: float, M: float, beta: float,
+                 sigma_n: float, h_c: float | None = None, p0_int_ini: float = 0.0,
+                 p0_floor_ratio: float = 1e-5) -> bool:
+    """Whether a layer of shear strength ``tau_p`` (Pa; the other quantities as :func:`weak_layer_material`) carries
+    the slab's ``sigma_n`` (Pa) intact and fails in shear: the closed forms alone, no shear-test run."""
+    try:
+        _closed_forms({}, E=E, nu=nu, density=density, D_wl=D_wl, M=M, beta=beta, sigma_n=sigma_n, h_c=h_c,
+                      xi=None, tau_p=tau_p, p_bond=None, p0_int_ini=p0_int_ini, p0_floor_ratio=p0_floor_ratio)
+    except InvalidArgument:
+        return False
+    return True
 
-    A bisection over the closed forms alone (no shear-test run): below it the layer yields in compaction (the
-    slab would crush it), so a layer observed intact under that slab is at least this strong.
+
+def least_shear_strength(lo: float = 0.0, tau_max: float = 1.0e5, **layer) -> float | None:
+    """The least shear strength (Pa) above ``lo`` at which the layer ``layer`` (the keywords of :func:`carries_slab`)
+    carries its slab and fails in shear, to 0.1 %; None when none up to ``tau_max`` does.
+
+    Below it the layer yields in compaction (the slab would crush it), so a layer observed intact under that slab
+    is at least this strong. The bracket grows from ``lo`` by doubling, then bisects.
     """
-    def ok(tau):
-        try:
-            _closed_forms({}, E=E, nu=nu, density=density, D_wl=D_wl, M=M, beta=beta, sigma_n=sigma_n, h_c=h_c,
-                          xi=None, tau_p=tau, p_bond=None, p0_int_ini=p0_int_ini, p0_floor_ratio=p0_floor_ratio)
-        except InvalidArgument:
-            return False
-        return True
-
-    if not ok(tau_max):
-        return None
-    lo, hi = 0.0, tau_max
+    hi = max(2.0 * lo, 1.0)
+    while not carries_slab(hi, **layer):
+        lo, hi = hi, 2.0 * hi
+        if hi > tau_max:
+            return None
     while hi - lo > 1e-3 * hi:
         mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if ok(mid) else (mid, hi)
+        lo, hi = (lo, mid) if carries_slab(mid, **layer) else (mid, hi)
     return hi
 
 

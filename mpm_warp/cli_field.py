@@ -1,0 +1,56 @@
+"""``mpm-warp field``: run every PST of real pits (CAAML folders, CSV tables) on Dask and score them."""
+
+from __future__ import annotations
+
+import sys
+
+__all__ = ["add_field"]
+
+DESCRIPTION = (
+    "Run every PST record of real snow pits as the field runs it (the saw stops once the crack runs away) and "
+    "measure the predicted outcome (END, SF, ARR) against what the observer wrote. INPUT: folders of CAAML "
+    "files, CAAML files, or CSV tables of PSTs (columns: id, outcome, slope_deg, column_cm, cut_cm, slab_cm and "
+    "slab_density or layers, weak_layer_cm, optional weak_layer_density, w_f, column_ends; docs/profiles.md). "
+    "Each case is a Dask task on a local cluster (--workers) or an existing one (--scheduler); a killed batch "
+    "resumes where it stopped. Writes the runs, cases.csv, refused.csv, scores.json and confusion.png to --out.")
+EXAMPLE = "example: mpm-warp field pits/ --out field-run --workers 2"
+
+
+def cmd_field(a) -> int:
+    """Exit status 0 when every case ran (refusals are not failures), 1 when some failed."""
+    from .field.batch import run_field
+    from .field.protocol import FieldProtocol
+
+    res = run_field(a.inputs, a.out, workers=a.workers, scheduler=a.scheduler, device=a.device, limit=a.limit,
+                    protocol=FieldProtocol(max_particles=a.max_particles), progress=not a.quiet)
+    sc = res.scores
+
+    def ba(k):
+        v = sc[k]["balanced_accuracy"]
+        return "-" if v is None else f"{v:.3f}"
+
+    print(f"field: {sc['cases']} cases scored ({res.skipped} from an earlier batch), {sc['failed']} failed, "
+          f"{len(res.refused)} records refused (refused.csv)\nbalanced accuracy: model {ba('model')}, majority "
+          f"class {ba('majority')}, weac static {ba('weac_static')}\nresults: {res.out_dir}")
+    for r in res.records:
+        if r.get("status") != "ok":
+            print(f"failed {r['id']}: {r.get('error')}", file=sys.stderr)
+    return 1 if sc["failed"] else 0
+
+
+def add_field(sub) -> None:
+    """The ``field`` subcommand on the CLI's subparsers ``sub``."""
+    from .field.protocol import FieldProtocol
+
+    p = sub.add_parser("field", help="run real pits' PSTs in bulk on Dask and score END/SF/ARR against the field",
+                       description=DESCRIPTION, epilog=EXAMPLE)
+    p.add_argument("inputs", nargs="+", metavar="INPUT", help="folder of CAAML files, a CAAML file, or a CSV table")
+    p.add_argument("--out", required=True, help="folder of the runs and results (an earlier batch's cases are kept)")
+    p.add_argument("--workers", type=int, help="workers of the local cluster (default: one per core)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--device", default="cpu", help="cpu | cuda | cuda:N (default cpu)")
+    p.add_argument("--limit", type=int, help="run only the first N runnable cases")
+    p.add_argument("--max-particles", type=int, default=FieldProtocol.max_particles,
+                   help=f"per-case budget: most particles of a column (default {FieldProtocol.max_particles:,})")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(func=cmd_field)

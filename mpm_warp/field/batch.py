@@ -1,0 +1,265 @@
+"""Run every PST of real pits in bulk on Dask and score the outcomes against what the observers wrote.
+
+:func:`run_field` takes folders of CAAML files and CSV tables of PSTs (:mod:`.table`), sets every record up
+(:mod:`.cases`), runs the runnable ones by the field protocol (:mod:`.protocol`) as Dask tasks on a local
+cluster or on a running scheduler, and writes to ``out_dir``::
+
+    CASE.h5, CASE.json   each case's run and its record (status, observed and predicted class, the cuts)
+    refused.csv          every record that could not be set up, one field-terms line each
+    cases.csv            one row per case: observed against predicted, recorded cut against the runaway cut
+    scores.json          confusion matrix, recall per class, balanced accuracy; the same for the baselines
+    confusion.png        the confusion matrix
+
+A batch killed at any point resumes where it stopped: a case whose JSON says "ok" and whose run file reads
+back is not run again. A case that raises is recorded as failed with its error and never stops the others.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import glob
+import hashlib
+import json
+import os
+import sys
+import time
+import traceback
+import uuid
+from dataclasses import dataclass
+
+from .. import io
+from ..errors import InvalidArgument, MPMError
+from .cases import FieldCase, FieldRefusal, field_case, field_cases
+from .protocol import FieldProtocol, decided, protocol_params
+from .scores import baseline_majority, field_class, scores
+from .static_rule import weac_static_class
+from .table import table_profiles
+
+__all__ = ["run_field", "gather", "FieldBatch"]
+
+
+@dataclass
+class FieldBatch:
+    """What :func:`run_field` returns: the case records, the refusals, the scores and the files written."""
+
+    records: list
+    refused: list
+    scores: dict
+    skipped: int
+    out_dir: str
+
+
+def gather(inputs) -> tuple[list[FieldCase], list[FieldRefusal]]:
+    """The cases and refusals of every input: a folder of CAAML files (``*.xml``, ``*.caaml``), one CAAML file,
+    or a CSV table of PSTs (:mod:`.table`)."""
+    cases, refused = [], []
+    for path in inputs:
+        path = os.fspath(path)
+        if os.path.isdir(path):
+            files = sorted(glob.glob(os.path.join(path, "*.xml")) + glob.glob(os.path.join(path, "*.caaml")))
+        elif path.lower().endswith(".csv"):
+            for row in table_profiles(path):
+                if row.refusal is not None:
+                    refused.append(FieldRefusal(os.path.basename(path), row.id, "table row", row.refusal))
+                    continue
+                r = field_case(row.profile, row.record, w_f=row.w_f)
+                (cases if isinstance(r, FieldCase) else refused).append(r)
+            continue
+        elif os.path.isfile(path):
+            files = [path]
+        else:
+            raise InvalidArgument("INPUT", path, "a folder of CAAML files, a CAAML file or a CSV table of PSTs")
+        for f in files:
+            for r in field_cases(f):
+                (cases if isinstance(r, FieldCase) else refused).append(r)
+    return cases, refused
+
+
+def _case_id(case: FieldCase, k: int) -> str:
+    stem = os.path.splitext(case.pit)[0].replace("#", "-").replace(" ", "_")
+    digest = hashlib.sha256(json.dumps(case.params.to_dict(), sort_keys=True, default=str).encode()).hexdigest()
+    return f"{stem}-{k}-{digest[:12]}"
+
+
+def _write_json(path: str, obj: dict) -> None:
+    tmp = f"{path}.{uuid.uuid4().hex[:8]}.tmp"
+    with open(tmp, "w") as fh:
+        json.dump(obj, fh, indent=1, default=str, allow_nan=False)
+        fh.write("\n")
+    os.replace(tmp, path)
+
+
+def _finite(x):
+    return x if isinstance(x, (int, float)) and x == x and abs(x) != float("inf") else None
+
+
+def run_case(task: dict) -> dict:
+    """One case in a worker (never raises: a failure is a record with its error)."""
+    from ..runner import run
+
+    t0 = time.perf_counter()
+    out = os.path.join(task["out_dir"], task["id"])
+    rec = {k: task[k] for k in ("id", "pit", "test", "observed", "recorded_cut", "static_class", "w_f",
+                                 "w_f_source", "setup")}
+    rec["status"] = "failed"
+    try:
+        res = run(task["scenario"], out + ".part.h5", device=task["device"], overwrite=True,
+                  callback=lambda sim, frame: not decided(sim))
+        o = res.scene_result.get("outcome", {})
+        rec.update(status="ok", predicted=o.get("class") or "running", field_line=o.get("field_line"),
+                   runaway_cut=_finite(res.scene_result.get("runaway_cut")),
+                   slab_fracture_at=_finite(o.get("slab_fracture_at")), note=o.get("note", ""),
+                   sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
+                   n_frames=io.read_run(out + ".part.h5").n_frames)
+        if os.path.exists(io.checkpoint_path_for(out + ".part.h5")):
+            os.replace(io.checkpoint_path_for(out + ".part.h5"), io.checkpoint_path_for(out + ".h5"))
+        os.replace(out + ".part.h5", out + ".h5")
+        rec["run_file"] = os.path.basename(out + ".h5")
+    except Exception as e:      # a failing case is recorded with its error; it never stops the batch
+        rec.update(status="failed", error=f"{type(e).__name__}: {e}", traceback=traceback.format_exc(limit=-4))
+    rec["case_wall_s"] = time.perf_counter() - t0
+    _write_json(out + ".json", rec)
+    return rec
+
+
+def _finished(task: dict) -> dict | None:
+    out = os.path.join(task["out_dir"], task["id"])
+    try:
+        with open(out + ".json") as fh:
+            rec = json.load(fh)
+        if rec.get("status") == "ok" and io.read_run(out + ".h5").n_frames == rec.get("n_frames"):
+            return rec
+    except (OSError, ValueError, MPMError):
+        pass
+    return None
+
+
+def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
+    from ..scenes.pst import build
+
+    tasks = []
+    for k, c in enumerate(cases):
+        params, tc, note = protocol_params(c.params, proto)
+        if params is None:
+            refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
+            continue
+        wf = c.fracture_energy
+        tasks.append({"id": _case_id(c, k), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
+                      "recorded_cut": c.record.cut_length, "static_class": weac_static_class(c.params),
+                      "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
+                      "setup": note, "scenario": build(params, tc, name="field"), "out_dir": out_dir,
+                      "device": device})
+    return tasks
+
+
+def _execute(todo, records, workers, scheduler, stream, total) -> None:
+    from distributed import Client, LocalCluster, as_completed
+
+    with contextlib.ExitStack() as stack:
+        if scheduler:
+            client = stack.enter_context(Client(scheduler))
+        else:
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                dashboard_address=None, silence_logs=40, env={"MPM_WARP_THREADS": "1"}))
+            client = stack.enter_context(Client(cluster))
+        token, t0, done = uuid.uuid4().hex[:8], time.perf_counter(), 0
+        futures = {client.submit(run_case, t, key=f"{t['id']}-{token}", retries=1, pure=False, priority=-i): t
+                   for i, t in enumerate(todo)}
+        for fut in as_completed(list(futures)):
+            task = futures[fut]
+            try:
+                rec = fut.result()
+            except Exception as e:   # the worker died too often, or the cluster is gone
+                rec = {"id": task["id"], "status": "failed", "error": f"{type(e).__name__}: {e}"}
+                _write_json(os.path.join(task["out_dir"], task["id"] + ".json"), rec)
+            fut.release()
+            records[task["id"]] = rec
+            done += 1
+            if stream is not None:
+                el = time.perf_counter() - t0
+                stream.write(f"\rfield: {total - len(todo) + done}/{total} cases, elapsed {el:.0f} s, "
+                             f"ETA {el / done * (len(todo) - done):.0f} s ")
+                stream.flush()
+        if stream is not None:
+            stream.write("\n")
+
+
+def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
+              device: str | None = "cpu", protocol: FieldProtocol | None = None, limit: int | None = None,
+              progress=True) -> FieldBatch:
+    """Set up, run and score every PST record of ``inputs`` (module docstring).
+
+    Parameters
+    ----------
+    inputs : list of str
+        Folders of CAAML files, CAAML files, CSV tables of PSTs.
+    out_dir : str
+        Folder of the runs and the results (created; an earlier batch's finished cases are kept and not rerun).
+    workers : int, optional
+        Worker processes of the local cluster (default: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        Address of a running Dask scheduler (mpm_warp installed on its workers; ``out_dir`` visible to them).
+    device : str, optional
+        Warp device of every run (default the CPU).
+    protocol : FieldProtocol, optional
+        The per-case budget and the saw (default :class:`~.protocol.FieldProtocol`).
+    limit : int, optional
+        Run only the first ``limit`` runnable cases (in input order).
+    progress : bool or text stream
+        One progress line on stderr (True), on the given stream, or none.
+    """
+    for name, v in (("workers", workers), ("limit", limit)):
+        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 1):
+            raise InvalidArgument(name, v, "an integer >= 1")
+    proto = (protocol or FieldProtocol()).validate()
+    cases, refused = gather(inputs)
+    cases = cases[:limit] if limit is not None else cases
+    os.makedirs(out_dir, exist_ok=True)
+    tasks = _tasks(cases, out_dir, proto, device, refused)
+    records = {t["id"]: _finished(t) for t in tasks}
+    todo = [t for t in tasks if records[t["id"]] is None]
+    stream = sys.stderr if progress is True else (progress or None)
+    if todo:
+        _execute(todo, records, workers, scheduler, stream, len(tasks))
+    recs = [records[t["id"]] for t in tasks]
+    _write_outputs(out_dir, recs, refused)
+    sc = score_records(recs)
+    _write_json(os.path.join(out_dir, "scores.json"), sc)
+    from .figures import plot_confusion
+
+    plot_confusion(sc, os.path.join(out_dir, "confusion.png"))
+    return FieldBatch(recs, refused, sc, len(tasks) - len(todo), out_dir)
+
+
+#: the columns of cases.csv
+CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "static_class", "recorded_cut", "runaway_cut",
+                "slab_fracture_at", "w_f", "w_f_source", "setup", "particles", "steps", "wall_s", "run_file", "error")
+
+
+def _write_outputs(out_dir: str, recs: list, refused: list) -> None:
+    with open(os.path.join(out_dir, "cases.csv"), "w", newline="") as fh:
+        w = csv.DictWriter(fh, CASE_COLUMNS, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(recs)
+    with open(os.path.join(out_dir, "refused.csv"), "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["pit", "test", "outcome", "reason", "message"])
+        w.writerows([r.pit, r.test, r.outcome or "", r.reason, r.message] for r in refused)
+
+
+def score_records(recs: list) -> dict:
+    """Scores of the model and of the baselines on the cases that ran (``status`` ok, an observed class)."""
+    ok = [r for r in recs if r.get("status") == "ok" and r.get("observed")]
+    obs = [r["observed"] for r in ok]
+    return {"cases": len(ok), "failed": sum(r.get("status") != "ok" for r in recs),
+            "model": scores(obs, [r["predicted"] for r in ok]),
+            "majority": scores(obs, baseline_majority(obs)),
+            "weac_static": scores(obs, [r.get("static_class") or "none" for r in ok]),
+            "wall_s": {"median": _median([r["wall_s"] for r in ok]), "total": sum(r["wall_s"] for r in ok)}}
+
+
+def _median(xs):
+    xs = sorted(xs)
+    return None if not xs else (xs[len(xs) // 2] if len(xs) % 2 else 0.5 * (xs[len(xs) // 2 - 1] + xs[len(xs) // 2]))

@@ -1,0 +1,88 @@
+"""The field protocol: how a field case is run, as an observer runs a PST, within a per-case budget.
+
+- **The saw** starts at the upslope end after settling and may cut to the column's far end; where the scene
+  supports it (``saw.stop = "runaway"``) it stops once the crack runs away from it, so that what follows is
+  the crack's own. A crack that never runs away before the saw reaches the end is "no propagation".
+- **The grid** resolves the weak layer with 4 cells (the resolution the snow ladders call resolved) when the
+  column then fits :attr:`FieldProtocol.max_particles`; else with 3, the fewest the model allows; else the
+  case is refused in one line (the column is too large for the budget).
+- **The run** lasts the settling, the saw's way to the end, and :attr:`FieldProtocol.tail` after it, and stops
+  at the first frame at which the outcome is decided (END, SF, an arrest after a runaway, no propagation).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+from ..config import TimeControl
+from ..scenes.pst import PSTParams
+
+__all__ = ["FieldProtocol", "protocol_params", "decided", "particle_estimate"]
+
+
+@dataclass(frozen=True)
+class FieldProtocol:
+    """How field cases run.
+
+    Attributes
+    ----------
+    max_particles : int
+        The per-case budget: most particles a column may have (2D).
+    cells_across : int
+        Grid cells across the weak layer when the budget allows (else 3).
+    saw_speed : float
+        Blade speed (m/s).
+    tail : float
+        Simulated time after the saw reached the far end (s).
+    frame_interval : float
+        Time between frames (s): the outcome is checked at every frame.
+    """
+
+    max_particles: int = 120_000
+    cells_across: int = 4
+    saw_speed: float = 1.0
+    tail: float = 0.3
+    frame_interval: float = 0.005
+
+    def validate(self) -> FieldProtocol:
+        """Check every value (one-line InvalidArgument naming it); return self."""
+        from ..checks import finite_number, positive_int
+
+        positive_int("max_particles", self.max_particles, lo=1000)
+        positive_int("cells_across", self.cells_across, lo=3, hi=16)
+        finite_number("saw_speed", self.saw_speed, lo=0.0, lo_open=True, hi=1.0)
+        finite_number("tail", self.tail, lo=0.0)
+        finite_number("frame_interval", self.frame_interval, lo=0.0, lo_open=True, hi=0.1)
+        return self
+
+
+def particle_estimate(p: PSTParams) -> int:
+    """Particles of the 2D column ``p`` (-): its area over the particle spacing squared."""
+    height = p.slab_depth + p.weak_layer_thickness + p.substratum_depth
+    spacing = p.dx / p.particles_per_cell
+    return int(math.ceil(p.length * height / spacing ** 2))
+
+
+def protocol_params(params: PSTParams, proto: FieldProtocol) -> tuple[PSTParams | None, TimeControl | None, str]:
+    """The field case ``params`` as the protocol runs it: ``(params, time, note)``, or ``(None, None, reason)``."""
+    saw_fields = {f.name for f in dataclasses.fields(params.saw)}
+    saw = dataclasses.replace(params.saw, cut_length=float(params.length), speed=proto.saw_speed,
+                              **({"stop": "runaway"} if "stop" in saw_fields else {}))
+    for cells in (proto.cells_across, 3):
+        dx = params.weak_layer_thickness / cells
+        p = dataclasses.replace(params, dx=dx, margin=max(params.margin, 2.0 * dx), saw=saw)
+        n = particle_estimate(p)
+        if n <= proto.max_particles:
+            end = p.saw_start + p.length / proto.saw_speed + proto.tail
+            note = f"{cells} cells across the weak layer, dx {dx * 1e3:.2f} mm, about {n:,} particles"
+            return p.validate("scene"), TimeControl(end=end, frame_interval=proto.frame_interval), note
+    return None, None, (f"the column is too large for the per-case budget: {n:,} particles at the coarsest grid "
+                        f"the weak layer allows (3 cells), above {proto.max_particles:,}")
+
+
+def decided(sim) -> bool:
+    """Whether the PST running in ``sim`` has its outcome (END, SF, or an arrest or no propagation once the saw is
+    done): the batch stops a run there."""
+    return sim.monitors["pst"].outcome().get("class") is not None

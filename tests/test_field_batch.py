@@ -1,0 +1,82 @@
+"""The field batch (mpm_warp.field.batch, ``mpm-warp field``): tables in, scores out, a killed batch resumes."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import pytest
+
+from mpm_warp.cli import main
+from mpm_warp.field.batch import run_field, score_records
+from mpm_warp.field.scores import baseline_majority, scores
+from mpm_warp.field.table import table_profiles
+
+TABLE = """id,outcome,slope_deg,column_cm,cut_cm,slab_cm,slab_density,weak_layer_cm,weak_layer_density,w_f,column_ends
+tiny-a,End,0,40,12,15,180,4,,0.3,
+tiny-b,Arr,0,40,15,15,180,4,,0.5,vertical
+no-slope,End,,100,30,30,200,3,,,
+"""
+
+
+def test_recall_balanced_accuracy_and_the_majority_baseline():
+    obs = ["END"] * 6 + ["SF"] * 2 + ["ARR"] * 2
+    pred = ["END"] * 5 + ["SF"] + ["END", "SF"] + ["ARR", "NP"]
+    s = scores(obs, pred)
+    assert s["recall"] == {"END": 5 / 6, "SF": 0.5, "ARR": 0.5}
+    assert s["balanced_accuracy"] == pytest.approx((5 / 6 + 0.5 + 0.5) / 3)
+    assert s["accuracy"] == pytest.approx(0.7)
+    assert s["confusion"]["columns"] == ["END", "SF", "ARR", "NP"]
+    assert s["confusion"]["counts"] == [[5, 1, 0, 0], [1, 1, 0, 0], [0, 0, 1, 1]]
+    # always the majority class: recall 1 for it, 0 for the others, balanced accuracy 1/3
+    assert scores(obs, baseline_majority(obs))["balanced_accuracy"] == pytest.approx(1 / 3)
+    assert scores([], [])["balanced_accuracy"] is None
+
+
+def test_a_table_row_becomes_a_profile_or_one_line(tmp_path):
+    path = tmp_path / "psts.csv"
+    path.write_text(TABLE)
+    rows = table_profiles(path)
+    a, b, bad = rows
+    assert a.refusal is None and a.record.field_line() == "PST 12/40 (End) down 15 cm" and a.w_f == 0.3
+    assert [ly.thickness for ly in a.profile.layers] == [0.15, 0.04] and a.profile.slope_angle == 0.0
+    assert b.profile.country == "US"                           # vertical ends, as the row asks
+    assert bad.profile is None
+    assert bad.refusal == "psts.csv: row 4 (no-slope): slope_deg is empty (a number is required)"
+    (tmp_path / "broken.csv").write_text("id,outcome\nx,End\n")
+    with pytest.raises(ValueError, match="columns slope_deg, column_cm, cut_cm, weak_layer_cm are missing"):
+        table_profiles(tmp_path / "broken.csv")
+
+
+def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
+    """The first run stops after one case (as a kill would); the second keeps that case's files untouched."""
+    table = tmp_path / "psts.csv"
+    table.write_text(TABLE)
+    out = str(tmp_path / "out")
+    first = run_field([str(table)], out, workers=1, limit=1, progress=False)
+    (rec,) = first.records
+    assert rec["status"] == "ok" and first.skipped == 0
+    done = os.path.join(out, rec["id"] + ".json")
+    stamp = os.stat(done).st_mtime_ns
+    again = run_field([str(table)], out, workers=1, progress=False)
+    assert again.skipped == 1 and len(again.records) == 2 and os.stat(done).st_mtime_ns == stamp
+    assert all(r["status"] == "ok" for r in again.records)
+    assert [r["observed"] for r in again.records] == ["END", "ARR"]
+    assert all(r["predicted"] in ("END", "SF", "ARR", "NP", "running") for r in again.records)
+    # the files a reader gets: the cases, the refusals, the scores of the model and its baselines, the figure
+    with open(os.path.join(out, "scores.json")) as fh:
+        sc = json.load(fh)
+    assert sc["cases"] == 2 and set(sc) >= {"model", "majority", "weac_static", "wall_s"}
+    assert sc == json.loads(json.dumps(score_records(again.records)))
+    with open(os.path.join(out, "refused.csv")) as fh:
+        assert "slope_deg is empty" in fh.read()
+    assert os.path.getsize(os.path.join(out, "confusion.png")) > 0
+
+
+def test_bad_batch_arguments_are_one_line(tmp_path, capsys):
+    assert main(["field", str(tmp_path / "nothing-here"), "--out", str(tmp_path / "o")]) == 2
+    assert "INPUT = " in capsys.readouterr().err
+    table = tmp_path / "psts.csv"
+    table.write_text(TABLE)
+    assert main(["field", str(table), "--out", str(tmp_path / "o"), "--workers", "0"]) == 2
+    assert "workers = 0 is invalid: expected an integer >= 1" in capsys.readouterr().err
