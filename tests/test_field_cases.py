@@ -42,6 +42,8 @@ RECORDS = [
      "has a measured density of 20 kg/m^3, outside the 50-600 kg/m^3 of seasonal dry snow: check the entry"),
     ("snowpits-48191", "PST 44/100 (End) down 100 cm", "failure depth",
      "the failure depth 100 cm is at or below the bottom of the described layers (100 cm)"),
+    ("snowpits-18285", "PST 30/100 (End) down 123 cm", "column shorter than slab",
+     "the column (100 cm) is not longer than the slab is deep (110 cm, normal to the slope)"),
     ("snowpits-17833", "PST 10/100 (Arr) down 20 cm", "fracture energy",
      "a weak-layer fracture energy of 0.0153 J/m^2 is below the least the model's weak layer dissipates"),
 ]

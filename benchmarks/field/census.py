@@ -70,6 +70,16 @@ def readers(files: list[str]) -> dict:
     return out
 
 
+def unreadable_records(path: str) -> collections.Counter:
+    """The PST outcomes a file we cannot read records, as snowpylot counts them (none if it cannot either)."""
+    from snowpylot import caaml_parser
+
+    try:
+        return collections.Counter(t.fracture_prop or "none" for t in caaml_parser(path).stability_tests.PST)
+    except Exception:           # a file no reader reads holds no countable record
+        return collections.Counter()
+
+
 def census(files: list[str]) -> dict:
     outcome, runnable, reasons = collections.Counter(), collections.Counter(), collections.Counter()
     by_reason_outcome, examples = collections.defaultdict(collections.Counter), collections.defaultdict(list)
@@ -80,7 +90,11 @@ def census(files: list[str]) -> dict:
         for r in field_cases(f):
             if not r.test:
                 unreadable += 1
-                reasons[r.reason] += 1
+                lost = unreadable_records(f)
+                outcome.update(lost)
+                reasons[r.reason] += sum(lost.values())
+                for o, n in lost.items():
+                    by_reason_outcome[r.reason][o] += n
                 examples[r.reason].append(r.line()) if len(examples[r.reason]) < 3 else None
                 continue
             outcome[r.outcome or "none"] += 1

@@ -36,7 +36,7 @@ from .scores import baseline_majority, field_class, scores
 from .static_rule import weac_static_class
 from .table import table_profiles
 
-__all__ = ["run_field", "gather", "FieldBatch"]
+__all__ = ["run_field", "run_cases", "gather", "score_records", "FieldBatch"]
 
 
 @dataclass
@@ -210,12 +210,21 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
     progress : bool or text stream
         One progress line on stderr (True), on the given stream, or none.
     """
-    for name, v in (("workers", workers), ("limit", limit)):
-        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 1):
-            raise InvalidArgument(name, v, "an integer >= 1")
-    proto = (protocol or FieldProtocol()).validate()
+    if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
+        raise InvalidArgument("limit", limit, "an integer >= 1")
     cases, refused = gather(inputs)
-    cases = cases[:limit] if limit is not None else cases
+    return run_cases(cases[:limit] if limit is not None else cases, refused, out_dir, workers=workers,
+                     scheduler=scheduler, device=device, protocol=protocol, progress=progress)
+
+
+def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
+              device: str | None = "cpu", protocol: FieldProtocol | None = None, progress=True) -> FieldBatch:
+    """Run the field cases ``cases`` (:func:`gather`'s, or a selection of them) and score them, as :func:`run_field`;
+    ``refused`` (their refusals) goes to ``refused.csv``."""
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise InvalidArgument("workers", workers, "an integer >= 1")
+    proto = (protocol or FieldProtocol()).validate()
+    refused = list(refused)
     os.makedirs(out_dir, exist_ok=True)
     tasks = _tasks(cases, out_dir, proto, device, refused)
     records = {t["id"]: _finished(t) for t in tasks}

@@ -153,6 +153,12 @@ def field_case(profile: SnowProfileData, rec: PSTRecord, *, base: PSTParams | No
         kind = ("failure depth" if msg.startswith("the failure depth") else
                 "slab density range" if "density of" in msg else "slab layer without density")
         return _refuse(pit, rec, kind, msg)
+    slab_normal = col.depth * math.cos(math.radians(profile.slope_angle))
+    if rec.column_length <= slab_normal:
+        return _refuse(pit, rec, "column shorter than slab", (
+            f"the column ({rec.column_length * 100:.0f} cm) is not longer than the slab is deep "
+            f"({slab_normal * 100:.0f} cm, normal to the slope): the model counts a crack as at the far end within one "
+            "slab depth of it, so such a column leaves the crack no room to run"))
     base = base if base is not None else PSTParams(slab_fracture=True, saw=Saw(cut_from="upslope"))
     params, notes = None, list(col.notes)
     try:

@@ -1,0 +1,90 @@
+"""Does the model predict a real PST's outcome (END, SF, ARR) better than the majority class and weac's static rule?
+
+Sets up every PST record of a folder of pits (the development set, docs/profiles.md), selects the runnable
+columns whose slab densities were all measured and a sample stratified by the observed class (``--per-class``
+of each of END, SF and ARR, drawn with ``--seed``, from the rest), and runs them by the field protocol on Dask
+(``mpm_warp.field.batch``, resumable: the runs stay in ``--runs``). Writes ``benchmarks/field/results/
+field_batch.json``: the selection, the scores of the model and of both baselines (confusion matrix, recall
+per class, balanced accuracy), the cost per case (median wall time, particles, steps) and the batch's rate.
+
+Usage: ``python benchmarks/field/field_batch.py DIR --runs RUNDIR [--per-class 50] [--workers 2]``; ``--quick``:
+two cases per class on a small budget, to a temporary folder. Hours of CPU for the full selection on 2 cores.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import sys
+import tempfile
+import time
+import warnings
+
+from mpm_warp.field.batch import gather, run_cases
+from mpm_warp.field.protocol import FieldProtocol
+from mpm_warp.field.scores import field_class
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+
+
+def all_measured(case) -> bool:
+    """Every slab layer's density was measured in the pit."""
+    return all(p.measured for p in case.column.slab)
+
+
+def select(cases, per_class: int, seed: int, measured: bool = True) -> tuple[list, dict]:
+    """The measured-density columns (when ``measured``) and a seeded sample of ``per_class`` per observed class."""
+    chosen = [c for c in cases if measured and all_measured(c)]
+    rest = [c for c in cases if not (measured and all_measured(c))]
+    rng = random.Random(seed)
+    counts = {"measured": len(chosen)}
+    for cls in ("END", "SF", "ARR"):
+        pool = [c for c in rest if field_class(c.outcome) == cls]
+        take = rng.sample(pool, min(per_class, len(pool)))
+        counts[cls] = len(take)
+        chosen += take
+    return chosen, counts
+
+
+def main(argv=None) -> int:
+    p = parser(__doc__, "two cases per class, no measured-density set, 30,000 particles")
+    p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
+    p.add_argument("--runs", help="folder of the runs (kept: a rerun resumes); default a temporary folder")
+    p.add_argument("--per-class", type=int, default=50, help="sampled cases per observed class (default 50)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the sample (default 0)")
+    p.add_argument("--workers", type=int, default=None, help="Dask workers (default one per core)")
+    p.add_argument("--max-particles", type=int, default=FieldProtocol.max_particles, help="per-case budget")
+    args = p.parse_args(argv)
+    warnings.filterwarnings("ignore")
+    t0 = time.perf_counter()
+    cases, refused = gather([args.data])
+    per, budget = (2, 30_000) if args.quick else (args.per_class, args.max_particles)
+    chosen, counts = select(cases, per, args.seed, measured=not args.quick)
+    runs = args.runs or tempfile.mkdtemp(prefix="mpm_warp_field_batch_")
+    env = environment(args.device)
+    t1 = time.perf_counter()
+    batch = run_cases(chosen, [], runs, workers=args.workers, device=args.device,
+                      protocol=FieldProtocol(max_particles=budget), progress=True)
+    wall = time.perf_counter() - t1
+    ok = [r for r in batch.records if r.get("status") == "ok"]
+    data = {"name": "field_batch", "data": os.path.basename(os.path.normpath(args.data)), "environment": env,
+            "selection": {"runnable": len(cases), "refused": len(refused), **counts, "seed": args.seed,
+                          "per_class": per, "max_particles": budget},
+            "workers": args.workers, "scores": batch.scores, "batch_wall_s": wall, "setup_wall_s": t1 - t0,
+            "cases_per_hour": 3600.0 * len(ok) / wall if wall > 0 and batch.skipped == 0 else None,
+            "resumed_cases": batch.skipped, "runs": runs,
+            "cases": [{k: r.get(k) for k in ("id", "test", "observed", "predicted", "static_class", "recorded_cut",
+                                             "runaway_cut", "w_f", "w_f_source", "particles", "steps", "wall_s",
+                                             "status", "error")} for r in batch.records]}
+    path = write_json("field_batch", data, out_dir(args, RESULTS, "field_batch"))
+    sc = batch.scores
+    print(f"{path}: {sc['cases']} cases, balanced accuracy model {sc['model']['balanced_accuracy']}, majority "
+          f"{sc['majority']['balanced_accuracy']}, weac static {sc['weac_static']['balanced_accuracy']}; median "
+          f"case {sc['wall_s']['median']} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
