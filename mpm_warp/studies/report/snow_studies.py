@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ..convergence import loglog_slope
 from .core import section
-from .fmt import DASH, bracket, env_note, finite, fx, pct, secs, spct, table
+from .fmt import DASH, bracket, check_line, env_note, finite, fx, pct, secs, spct, table
 
 
 def _column(data: dict) -> str:
@@ -137,15 +137,24 @@ def render_long_speed_trends(data: dict, ctx) -> list[str]:
                   "project's PSTs: critical cuts, column ends, where the slab's tension peaks?")
 def render_weac(data: dict, ctx) -> list[str]:
     lad = data.get("ladder") or {}
-    rows = [[f"`{k}`", fx(c["critical_cut"], 3), fx(c.get("weac_3_3_1"), 3), "yes" if c.get("agrees_to_3_digits")
+    rows = [[f"`{k}`", fx(c["critical_cut"], 3), fx(c.get("weac_3_3_1_recorded", c.get("weac_3_3_1")), 3),
+             "yes" if c.get("agrees_to_3_digits")
              else "no", fx(c["G_I"] / c["G"], 2) if finite(c.get("G")) and c["G"] else DASH,
              fx(c.get("free_end_deflection_m"), 2, 1e3), fx(c.get("weac_collapse_height_m"), 2, 1e3),
              fx(c.get("critical_cut_weak_layer_weight_on_slab"), 3)] for k, c in lad.items()]
     out = [f"The ladder PST's column, energy criterion at G_c = {fx(data.get('G_c'), 2)} J/m^2:", ""]
-    out += table(["case", "critical cut (m)", "weac 3.3.1 (m)", "agree to 3 digits", "G_I / G",
+    out += table(["case", "critical cut (m)", "weac 3.3.1, recorded (m)", "agree to 3 digits", "G_I / G",
                   "free end's deflection (mm)", "weac collapse height (mm)", "with the layer's weight on the slab (m)"],
                  rows)
     out += ["", env_note(data, verb="computed"), ""]
+    source = data.get("weac_3_3_1_source") or "recorded from weac 3.3.1, computed outside this project"
+    out += [f"The critical cut is computed with the installed weac ({data['environment'].get('weac') or '?'}); the "
+            f"weac 3.3.1 column is not computed here: {source}.", ""]
+    chk = (data.get("checks") or {}).get("installed_weac_matches_weac_3_3_1_recorded")
+    if chk:
+        fails = [k for k, c in chk["cases"].items() if not c["pass"]]
+        out += [check_line("installed weac against weac 3.3.1 (recorded)", chk["criterion"], chk["pass"],
+                           "off in " + ", ".join(fails) if fails else ""), ""]
     ends = data.get("column_ends") or {}
     if ends:
         out += ["Slope-normal against vertical column ends (the column's length and slope angle in its name):", ""]
