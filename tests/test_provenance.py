@@ -116,7 +116,6 @@ KNOWN_DIRTY = {
         "python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope",   # hours
     "snow/results/snow_long_speed_trends.json": "python benchmarks/snow/long_speed_trends.py",   # hours
     "snow/results/snowpack_critical_cut.json": "python benchmarks/snow/snowpack_critical_cut.py",  # hours
-    "snow/results/weac_static_pst.json": "python benchmarks/snow/weac_static_pst.py",            # seconds
 }
 
 

@@ -150,7 +150,8 @@ def main(argv=None) -> None:
     data["checks"] = checks(data)
     print(write_json("weac_static_pst", data, out_dir(a, RESULTS, "weac_static_pst")))
     for k, v in data["ladder"].items():
-        print(f"{k}: a_c {v['critical_cut']:.4f} m (weac 3.3.1, recorded {v['weac_3_3_1_recorded']}), G_I/G {v['G_I'] / v['G']:.2f}, "
+        print(f"{k}: a_c {v['critical_cut']:.4f} m (weac 3.3.1, recorded {v['weac_3_3_1_recorded']}), "
+              f"G_I/G {v['G_I'] / v['G']:.2f}, "
               f"end deflection {v['free_end_deflection_m'] * 1e3:.2f} mm, with the layer's weight "
               f"{v['critical_cut_weak_layer_weight_on_slab']:.4f} m")
     for k, row in data["column_ends"].items():
