@@ -10,7 +10,7 @@ from ...scenes.pst.analysis import SPEED_LIMIT_DISTANCE, SPEED_WINDOW
 from .. import snow as refs
 from ..snow import DEM_STEADY_MAX, FIELD_CUT, FIELD_SPEED, LADDER_PST, LONG_PST_SPEED, STEADY_FROM
 from .core import section
-from .fmt import DASH, bracket, count, env_note, finite, fx, secs, spct, table
+from .fmt import DASH, bracket, check_line, count, env_note, finite, fx, secs, spct, table
 
 
 def _pst_command(data: dict) -> str:
@@ -264,6 +264,10 @@ def render_shear_test(data: dict, ctx) -> list[str]:
                     f"{fx(res[0].get('collapse_fraction_law'), 3)}"),
             row("critical-state law at the final pressure", "collapse_fraction_critical_state", 3),
             row("final pressure p", "p_final", 0, 1.0, "Pa"),
+            row("largest pressure p_max of the push", "p_max", 0, 1.0, "Pa"),
+            ["the law at p_max: p0 = p_max (cap) to 2 p_max (critical state)",
+             *[f"{fx(x.get('collapse_fraction_isotropic_at_p_max'), 3)} to "
+               f"{fx(x.get('collapse_fraction_critical_state_at_p_max'), 3)}" for x in res], ""],
             ["bond lost", *["yes" if x.get("bond_lost") else "no" for x in res], ""]]
     out = table(["quantity", *[f"{r['cells']} cells (dx {fx(r['dx'] * 1e3, 2)} mm)" for r in runs], "reference"],
                 rows, ["l"] * (len(runs) + 2))
@@ -272,4 +276,33 @@ def render_shear_test(data: dict, ctx) -> list[str]:
     if ch:
         out += ["", f"From {runs[0]['cells']} to {runs[-1]['cells']} cells: peak {spct(ch.get('peak_shear_stress'))}, "
                 f"softening slip {spct(ch.get('softening_displacement'))}."]
+    return out + shear_checks(data)
+
+
+def shear_checks(data: dict) -> list[str]:
+    """The pass lines of the shear test against its references (the run takes two minutes; criteria here).
+
+    - Interior softening slip within 25 % of the given ``delta_s`` (SI Note 2's 2 mm; the test's 0.5 mm).
+    - Collapse between the Cam-Clay law at the largest pressure of the push, ``p0 = p_max`` to ``2 p_max``
+      (the final pressure comes after the layer unloads: it is no bound, docs of
+      :func:`~mpm_warp.scenes.shear_test.analyze_shear_series`).
+    """
+    res = [r["result"] for r in data["runs"]]
+    out = [""]
+    si = data.get("si_softening_slip")
+    ds = [x.get("softening_displacement") for x in res]
+    if finite(si) and all(finite(d) for d in ds):
+        out.append(check_line("softening slip against SI Note 2", f"the interior's slip from peak to bond loss within "
+                              f"25 % of the given {fx(si, 1, 1e3)} mm at every resolution",
+                              all(abs(d / si - 1.0) <= 0.25 for d in ds),
+                              ", ".join(f"{fx(d, 3, 1e3)} mm" for d in ds)))
+    lo = [x.get("collapse_fraction_isotropic_at_p_max") for x in res]
+    hi = [x.get("collapse_fraction_critical_state_at_p_max") for x in res]
+    col = [x.get("collapse_fraction") for x in res]
+    if all(finite(v) for v in lo + hi + col):
+        out.append(check_line("collapse against the Cam-Clay law", "1 - J_P between the law at the push's largest "
+                              "pressure with p0 = p_max and with p0 = 2 p_max (critical state) at every resolution",
+                              all(a <= c <= b for a, c, b in zip(lo, col, hi, strict=True)),
+                              ", ".join(f"{fx(c, 3)} in [{fx(a, 3)}, {fx(b, 3)}]"
+                                        for a, c, b in zip(lo, col, hi, strict=True))))
     return out
