@@ -154,6 +154,58 @@ def render_pst(data: dict, ctx) -> list[str]:
     out += ["", env_note(data)]
     if data.get("resume_note"):
         out += ["", f"Resumed: {data['resume_note']}."]
+    return out + pst_checks(r, data.get("scene_slab_thickness") or 0.0, given.get("slope_angle") or 0.0)
+
+
+#: Heierli's steady anticrack (speed, touchdown) and the calibrated collapse height: a run within 25 % agrees
+HEIERLI_TOLERANCE = 0.25
+
+
+def pst_checks(r: dict, slab_thickness: float, slope: float) -> list[str]:
+    """The pass lines of a full PST against its references (the runs take 45-85 min: criteria stated here).
+
+    - Mean speed over the reported span inside the short field PSTs' range (:data:`FIELD_SPEED`).
+    - Mean speed and touchdown within :data:`HEIERLI_TOLERANCE` of Heierli's with the run's collapse.
+    - Steady speed: flat, inside the long PSTs' range and at most :data:`DEM_STEADY_MAX` c_s; on a slope,
+      supershear up to :data:`~mpm_warp.studies.snow.SUPERSHEAR_MAX` c_s.
+    - Collapse height behind the front within :data:`HEIERLI_TOLERANCE` of the calibrated (oedometric) one.
+    """
+    out = [""]
+    v, cs = r.get("damage_speed_mean"), r.get("shear_wave_speed")
+    sup = speed_profile_summary(r, "damage")["supershear"]
+    accel = (f"; on this {slope:g} deg slope the crack speeds up along the column, faster than c_s from "
+             f"{sup[0]:.2f} m" if sup else "") if slope else ""
+    if finite(v):
+        ok = FIELD_SPEED[0] <= v <= FIELD_SPEED[1]
+        out.append(check_line("mean speed against short field PSTs", f"inside {FIELD_SPEED[0]:g}-{FIELD_SPEED[1]:g} "
+                              "m/s (Bergfeld et al. 2021)", ok, fx(v, 1, unit="m/s") + ("" if ok else accel)))
+    tol = f"{100 * HEIERLI_TOLERANCE:.0f} %"
+    for key, ref_key, what in (("damage_speed_mean", "heierli_speed_run", "mean speed"),
+                               ("touchdown", "heierli_touchdown_run", "touchdown")):
+        x, h = r.get(key), r.get(ref_key)
+        if finite(x) and finite(h) and h:
+            ok = abs(x / h - 1.0) <= HEIERLI_TOLERANCE
+            why = spct(x / h - 1.0) + ("" if ok or not slope else "; Heierli's steady anticrack is driven by the "
+                                       "slab's collapse alone, with no downslope pull" + accel)
+            out.append(check_line(f"{what} against Heierli", f"within {tol} of Heierli's with the run's collapse",
+                                  ok, why))
+    st = steady_speed(r, slab_thickness)
+    if st is not None and finite(cs):
+        if slope:
+            ok = cs < st <= refs.SUPERSHEAR_MAX * cs
+            crit = f"supershear, above c_s and at most {refs.SUPERSHEAR_MAX:g} c_s"
+        else:
+            ok = LONG_PST_SPEED[0] <= st <= LONG_PST_SPEED[1] and st <= DEM_STEADY_MAX * cs
+            crit = (f"inside {LONG_PST_SPEED[0]:g}-{LONG_PST_SPEED[1]:g} m/s (Bergfeld et al. 2022) and at most "
+                    f"{DEM_STEADY_MAX:g} c_s (Bobillier et al. 2024)")
+        out.append(check_line("steady speed", crit, ok, f"{fx(st, 1)} m/s, {st / cs:.2f} c_s"))
+    h, hc = r.get("collapse_height"), r.get("collapse_height_calibrated")
+    if finite(h) and finite(hc) and hc:
+        ok = abs(h / hc - 1.0) <= HEIERLI_TOLERANCE
+        out.append(check_line("collapse height against the calibrated law", f"within {tol} of the calibrated "
+                              "(oedometric) h_c", ok, spct(h / hc - 1.0) + ("" if ok else "; a layer sheared as it "
+                              "fails compacts past the oedometric law, towards the critical state (as in the shear "
+                              "test)")))
     return out
 
 
@@ -165,6 +217,10 @@ for _name in ("pst_flat", "pst_slope"):
 
 
 # ----------------------------------------------------------------------------- critical cut
+#: A bisected critical cut agrees with weac's static one (or a closed form) within 20 %, as in the snowpack study:
+#: weac lacks the weak layer's weight (6-13 % shorter cuts, docs/weac.md), the MPM resolves the layer by 6 cells.
+CUT_TOLERANCE = 0.20
+
 def _in_todays_keys(case: dict) -> tuple[float, str, list[str], bool]:
     """A critical-cut case's slope (deg, >= 0), the end the saw starts from and its overrides in today's keys,
     and whether the JSON records the older form: before ``saw.cut_from`` a negative ``scene.slope_angle`` meant
@@ -201,7 +257,7 @@ def _ladder_reference(ctx, dx: float):
                   "stop position, trial runs forked from one base run.)")
 def render_critical_cut(data: dict, ctx) -> list[str]:
     weac = (ctx.load("snow/results/weac_static_pst.json") or {}).get("ladder") or {}
-    rows, overrides, vals, older = [], [], [], []
+    rows, overrides, vals, older, with_weac = [], [], [], [], []
     for name, c in data["cases"].items():
         slope, end, todays, was_older = _in_todays_keys(c)
         if was_older:
@@ -209,6 +265,8 @@ def render_critical_cut(data: dict, ctx) -> list[str]:
         ref = _ladder_reference(ctx, c["dx"]) if _weac_key(c) else None
         wk = _weac_key(c)
         w = (weac.get(wk) or {}).get("critical_cut") if wk else None
+        if finite(w) and c.get("bracketed"):
+            with_weac.append((name, c, w))
         v = c.get("value")
         if c.get("bracketed"):
             vals.append(v)
@@ -231,9 +289,22 @@ def render_critical_cut(data: dict, ctx) -> list[str]:
                 "today a negative angle only mirrors the column."]
     if vals:
         inside = all(FIELD_CUT[0] <= v <= FIELD_CUT[1] for v in vals)
-        out += ["", f"Every bracketed cut {'lies' if inside else 'does not lie'} within the field's "
-                f"{FIELD_CUT[0]:g}-{FIELD_CUT[1]:g} m ({fx(min(vals), 3)}-{fx(max(vals), 3)} m). weac's column is the "
-                "ladder's, static, with its energy criterion at the same fracture energy."]
+        out += ["", "weac's column is the ladder's, static, with its energy criterion at the same fracture energy.", "",
+                check_line("against the field", f"every bracketed cut within the field's {FIELD_CUT[0]:g}-"
+                           f"{FIELD_CUT[1]:g} m", inside, f"{fx(min(vals), 3)}-{fx(max(vals), 3)} m")]
+    rel = [(name, c["value"] / w - 1.0) for name, c, w in with_weac if finite(c.get("value"))]
+    if rel:
+        ok = all(abs(x) <= CUT_TOLERANCE for _, x in rel)
+        out.append(check_line("against weac", f"each ladder case's cut within {100 * CUT_TOLERANCE:.0f} % of weac's "
+                              "static critical cut", ok, ", ".join(f"`{n}` {spct(x)}" for n, x in rel)))
+    gaume = [(name, c["value"] / c["gaume"] - 1.0) for name, c in data["cases"].items()
+             if finite(c.get("value")) and finite(c.get("gaume")) and c.get("bracketed")]
+    if gaume:
+        ok = all(abs(x) <= CUT_TOLERANCE for _, x in gaume)
+        out.append(check_line("against Gaume et al. 2017", f"each cut within {100 * CUT_TOLERANCE:.0f} % of the "
+                              "closed form", ok, ", ".join(f"`{n}` {spct(x)}" for n, x in gaume)
+                              + ("" if ok else "; the bisected cuts agree with weac's energy criterion, so the gap is "
+                                 "the closed form's; why it is longer is not established here")))
     return out
 
 
