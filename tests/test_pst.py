@@ -270,8 +270,10 @@ def test_pst_demo_small_crack_runs_away_from_the_saw(tmp_path):
     # sub-Rayleigh, and the slab followed the layer: the deflection front ran with the damage front
     assert ex["damage_speed_max"] < ex["rayleigh_speed"]
     assert ex["deflection_front_final"] >= p.length - p.slab_thickness
-    # the debonded layer collapsed under the slab, not beyond the calibrated law (4.6 mm for 3 cm)
-    assert 0.0 < ex["collapse_height"] <= 1.05 * ex["collapse_height_calibrated"]
+    # the debonded layer collapsed under the slab: by 0.75 s 39 % of the calibrated law's 4.6 mm for 3 cm
+    # (1.78 mm measured; at 3 cells across the layer the collapse is under-resolved and still going on, as on the
+    # PST ladder's 3-cell level). A layer that collapses half as much, or past the law, fails here.
+    assert ex["collapse_height"] / ex["collapse_height_calibrated"] == pytest.approx(0.387, abs=0.04)
     # the series are in the run file, with units
     run = mw.read_run(out)
     assert run.units["front"] == "m" and run.units["deflection_front"] == "m" and run.units["marker0_uy"] == "m"

@@ -70,7 +70,11 @@ def test_the_slab_crack_detector_finds_a_through_crack_and_not_a_partial_one():
     sim = mw.Simulation(sc, device="cpu")
     mon = pst.attach(sim)
     det = mon.slab_crack
-    assert isinstance(det, SlabCrackDetector)
+    # it watches the slab and nothing else: 0.8 m x 12 cm at 2 x 2 particles per 1 cm cell = 3840 particles in
+    # 24 rows and 80 bins of 1 cm, and a through-crack may lean over one slab thickness (12 bins)
+    assert type(det) is SlabCrackDetector and [g.name for g in det.groups] == ["slab"]
+    assert det.groups[0].count == 3840 and det.n_rows == 24 and det.window == 12
+    assert (det.bins.min(), det.bins.max()) == (0, 79) and np.bincount(det.bins).tolist() == [48] * 80
     g = det.groups[0]
     x0 = g.x0
     kappa = np.zeros(g.count)

@@ -2,7 +2,9 @@
 
 import math
 import os
+import re
 
+import matplotlib.image as mpimg
 import pytest
 
 import mpm_warp as mw
@@ -12,6 +14,8 @@ from mpm_warp.loader import resolved_scenario, scenario_from_dict
 from mpm_warp.scenes import pst
 from mpm_warp.scenes.density_laws import bergfeld_modulus
 from mpm_warp.scenes.profile import example_path
+from mpm_warp.scenes.pst.static import static_column
+from mpm_warp.scenes.weac_reference import critical_cut
 
 COS35 = math.cos(math.radians(35.0))
 
@@ -30,8 +34,8 @@ def test_the_example_profile_gives_the_pst_its_snowpack():
     (sub,) = p.substratum_stack()
     assert sub.thickness == pytest.approx(0.15) and sub.density == pytest.approx(300.0)
     assert len(p.profile.sha256) == 64
-    assert p.profile.weak_layer.startswith("slab 48 cm (2 layers), weak layer 2 cm (the profile layer's own "
-                                           "(SH, 2 cm))")
+    assert p.profile.weak_layer.startswith(
+        "slab 48 cm (2 layers), weak layer 2 cm (the profile layer's own (SH, 2 cm))")
     assert p.profile.weak_layer.endswith("in layer 2 (depth 0.48-0.5 m): SH F")
     # the layers load the weak layer: sum rho g h cos(slope)
     assert p.sigma_n == pytest.approx(9.81 * COS35 * COS35 * (81.0 * 0.10 + 230.0 * 0.38), rel=1e-9)
@@ -84,9 +88,18 @@ def test_the_profile_runs_to_a_picture_and_a_summary_in_one_command(tmp_path, ca
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "field: PST 40/40" in text and "down 48 cm" in text        # the cut, the column, the depth as measured
-    assert "weac 2.6" in text and "critical cut" in text
-    pictures = [line for line in text.splitlines() if line.endswith(".png")]
-    assert pictures and all(os.path.getsize(f) > 10_000 for f in pictures)
+    # weac's critical cut of this column, as the summary prints it, is weac's answer for the profile's column
+    # (0.261 m: its slope-normal layer thicknesses, h cos 35 deg, and the weak layer's w_f of 0.08 J/m^2)
+    sc = mw.load_scenario("pst_profile", ["scene.length=0.4"])
+    want = critical_cut(static_column(sc.scene), sc.scene.weak_layer.w_f)
+    got = re.search(r"weac 2\.6\.\d+: critical cut (\d\.\d{3}) m", text)
+    assert got and float(got.group(1)) == pytest.approx(want, abs=5e-4) and want == pytest.approx(0.261, abs=2e-3)
+    # the four pictures, and the PST picture shows the column (10.5 % of its pixels drawn)
+    pictures = sorted(os.path.basename(line) for line in text.splitlines() if line.endswith(".png"))
+    assert pictures == ["energy.png", "front.png", "markers.png", "pst.png"]
+    png = [line for line in text.splitlines() if line.endswith("pst.png")][0]
+    rgb = mpimg.imread(png)[..., :3]
+    assert (rgb.min(axis=2) < 0.95).mean() > 0.08
     assert main(["profile", str(example_path())]) == 0
     assert "PST 32/100 (End) down 48 cm" in capsys.readouterr().out
 

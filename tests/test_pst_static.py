@@ -22,7 +22,7 @@ def test_the_ladder_pst_in_weac_is_a_direct_weac_call():
                               weak_layer_nu=0.3, length=2.2)
     assert static_column(sc.scene) == by_hand
     assert ans["critical_cut"] == pytest.approx(wr.critical_cut(by_hand, 0.79), rel=1e-6)
-    assert round(ans["critical_cut"], 3) == 0.380                        # weac 3.3.1 gives 0.380 m too
+    assert round(ans["critical_cut"], 3) == 0.380                        # recorded from weac 3.3.1: 0.380 m too
     G = wr.energy_release_rate(by_hand, sc.scene.saw.cut_length)
     assert (ans["energy_release_rate"], ans["G_I"], ans["G_II"]) == pytest.approx(G, rel=1e-6)
     assert ans["G_c"] == 0.79 and ans["weac"].startswith("2.6")

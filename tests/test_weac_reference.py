@@ -68,8 +68,11 @@ def test_critical_cut_is_the_root_of_a_direct_weac_call(ours, theirs):
     assert wr.critical_cut(column(*ours), W_F) == pytest.approx(want, rel=1e-6)
 
 
-def test_critical_cuts_match_weac_3_3_1_for_the_ladder_pst():
-    """Issue 21's independent values (weac 3.3.1): flat 0.380 m, 30 deg from downslope 0.382 m, upslope 0.452 m."""
+def test_installed_weac_rounds_to_the_values_recorded_from_weac_3_3_1():
+    """The installed weac (2.6 here) computes the ladder PST's critical cuts; they round to the values recorded
+    from weac 3.3.1 (``WEAC_3_3_1_RECORDED`` of ``benchmarks/snow/weac_static_pst.py``: computed outside this
+    project, quoted in issue 21; weac 3 needs Python >= 3.12): flat 0.380 m, 30 deg from downslope 0.382 m,
+    from upslope 0.452 m."""
     assert round(wr.critical_cut(column(0.0), W_F), 3) == 0.380
     assert round(wr.critical_cut(column(30.0, "downslope"), W_F), 3) == 0.382
     assert round(wr.critical_cut(column(30.0, "upslope"), W_F), 3) == 0.452

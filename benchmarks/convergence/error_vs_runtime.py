@@ -48,7 +48,7 @@ import time
 from mpm_warp.errors import SimulationBlowUp
 from mpm_warp.finite_json import dump_finite, load_json
 from mpm_warp.studies.convergence import observed_order, time_to_target
-from mpm_warp.studies.environment import environment
+from mpm_warp.studies.environment import check_provenance, environment
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import PROBLEMS
 
@@ -279,6 +279,7 @@ def main(argv=None) -> int:
                   f"(runs {r['runs']}), steps {r.get('steps')}, particles {r.get('n_particles')}", flush=True)
             p["summary"] = summarise(name, p["dx_ladder"], p["dt_ladder"])
             data["wall_time_benchmark_s"] = time.perf_counter() - t_all
+            check_provenance(folder, data)                # no result from uncommitted code in results
             with open(path + ".tmp", "w") as fh:
                 dump_finite(data, fh, indent=1, default=float)
             os.replace(path + ".tmp", path)

@@ -55,7 +55,7 @@ from mpm_warp.camclay_forms import oedometric_ratio
 from mpm_warp.finite_json import dump_finite, load_json
 from mpm_warp.materials import hardening_collapse
 from mpm_warp.studies.convergence import observed_order
-from mpm_warp.studies.environment import environment
+from mpm_warp.studies.environment import check_provenance, environment
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import G, oedometric_collapse, run_column, weak_layer_column
 
@@ -245,7 +245,8 @@ def main(argv=None) -> int:
 
 
 def _write(path: str, data: dict) -> None:
-    """The JSON through a temporary file (a kill leaves the previous one)."""
+    """The JSON through a temporary file (a kill leaves the previous one); a dirty result is refused in results."""
+    check_provenance(os.path.dirname(path) or ".", data)
     with open(path + ".tmp", "w") as fh:
         dump_finite(data, fh, indent=1)
     os.replace(path + ".tmp", path)

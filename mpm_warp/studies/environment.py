@@ -1,4 +1,9 @@
-"""The environment record of a study's result (device, versions, date, load, CPU, commit), and its JSON file."""
+"""The environment record of a study's result (device, versions, date, load, CPU, commit), and its JSON file.
+
+A result in the committed results folders (``benchmarks/<group>/results/``) must name the code that made
+it: :func:`write_json` refuses to write one there from a dirty tree (:func:`check_provenance`); a
+``--quick`` run, or one with ``--out`` elsewhere, still writes, its ``git_commit`` marked ``+dirty``.
+"""
 
 from __future__ import annotations
 
@@ -7,13 +12,20 @@ import importlib.metadata
 import os
 import platform
 import subprocess
+import sys
 
 import warp as wp
 
 from ..finite_json import dump_finite
 from ..result import versions
 
-__all__ = ["environment", "git_commit", "write_json"]
+__all__ = ["environment", "git_commit", "write_json", "is_committed_results", "dirty_marks", "check_provenance",
+           "DirtyResultError"]
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+"""The checkout this package runs from (its ``benchmarks/`` holds the committed results)."""
+DIRTY_MARKS = ("+dirty", "uncommitted")
+"""What a commit string holds when the code that made a result was not committed."""
 
 
 def environment(device: str | None) -> dict:
@@ -58,6 +70,69 @@ def git_commit(path: str | None = None) -> str | None:
     return head.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
 
 
+class DirtyResultError(SystemExit):
+    """A result from uncommitted code was to be written into the committed results (exits with its line)."""
+
+
+def is_committed_results(folder: str, root: str | None = None) -> bool:
+    """Whether ``folder`` is (under) a committed results folder ``<root>/benchmarks/<group>/results``.
+
+    ``root`` is the checkout (default :data:`REPO_ROOT`); symbolic links are resolved on both sides.
+    """
+    rel = os.path.relpath(os.path.realpath(folder), os.path.realpath(root or REPO_ROOT))
+    parts = rel.split(os.sep)
+    return len(parts) >= 3 and parts[0] == "benchmarks" and parts[2] == "results"
+
+
+def dirty_marks(data) -> list[str]:
+    """Every commit string in ``data`` (nested dicts and lists) marked as uncommitted code (:data:`DIRTY_MARKS`).
+
+    The keys read are those naming a commit: ``git_commit``, ``commit`` and ``git_commit_*`` (a merged
+    result keeps the commit of each run it merges).
+    """
+    found: list[str] = []
+    if isinstance(data, dict):
+        for k, v in data.items():
+            if isinstance(v, str) and (k in ("git_commit", "commit") or k.startswith("git_commit_")):
+                if any(m in v for m in DIRTY_MARKS):
+                    found.append(v)
+            else:
+                found += dirty_marks(v)
+    elif isinstance(data, (list, tuple)):
+        for v in data:
+            found += dirty_marks(v)
+    return found
+
+
+def check_provenance(folder: str, data: dict | None = None, root: str | None = None) -> None:
+    """Refuse (raise :class:`DirtyResultError`) a result from uncommitted code bound for the committed results.
+
+    Outside the committed results (``--quick``, ``--out`` elsewhere) nothing is refused: the result's
+    ``git_commit`` carries ``+dirty``. Inside them, the commits ``data`` records decide (the code is
+    the one loaded when the run started, so an edit made while it runs does not void it); ``data``
+    recording none (or None: the check a script makes before a long run) asks the checkout now.
+    """
+    if not is_committed_results(folder, root):
+        return
+    marks = dirty_marks(data) if data is not None else []
+    if data is None or not _records_commit(data):
+        now = git_commit(root or REPO_ROOT)
+        marks = [now] if now and any(m in now for m in DIRTY_MARKS) else []
+    if marks:
+        raise DirtyResultError(
+            f"refused: a result from uncommitted code ({marks[0]}) cannot go into the committed results "
+            f"{folder}; commit your changes and rerun, or write elsewhere with --out DIR (or --quick)")
+
+
+def _records_commit(data) -> bool:
+    if isinstance(data, dict):
+        return any((k in ("git_commit", "commit") or k.startswith("git_commit_")) and isinstance(v, str)
+                   or _records_commit(v) for k, v in data.items())
+    if isinstance(data, (list, tuple)):
+        return any(_records_commit(v) for v in data)
+    return False
+
+
 def _version_str(v) -> str | None:
     return ".".join(str(p) for p in v) if v else None
 
@@ -69,7 +144,15 @@ def write_json(name: str, data: dict, results_dir: str, end_load: bool = True) -
     the start (how busy the shared machine was), unless ``end_load`` is False (a result re-derived from a
     stored run keeps its run's record). No inf or NaN is written: a non-finite number becomes null
     with its reason under ``<key>_null`` (:func:`~mpm_warp.finite_json.finite_json`).
+
+    Into a committed results folder a result from uncommitted code is refused (:func:`check_provenance`
+    raises :class:`DirtyResultError`: one line, nothing written); elsewhere it is written, and a line on
+    stderr says it is marked dirty.
     """
+    check_provenance(results_dir, data)
+    marks = dirty_marks(data)
+    if marks:
+        print(f"note: {name}.json is marked dirty ({marks[0]}): not a result to commit", file=sys.stderr)
     if end_load and isinstance(data.get("environment"), dict):
         data["environment"]["load_average_at_end_1_5_15_min"] = list(os.getloadavg())
     os.makedirs(results_dir, exist_ok=True)

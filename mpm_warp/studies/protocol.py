@@ -3,7 +3,7 @@
 A full run writes its JSON (and figure) to the committed results beside the script
 (``benchmarks/<group>/results/``): running the benchmark is asking for that. ``--quick`` runs a small
 case on the CPU in about a minute and writes to a new temporary folder, never over the committed
-results, unless ``--out`` names a folder.
+results, unless ``--out`` names a folder. A full run from a dirty checkout is refused (commit first).
 """
 
 from __future__ import annotations
@@ -38,12 +38,20 @@ def parser(doc: str, quick: str, device: str | None = "cpu") -> argparse.Argumen
 
 
 def out_dir(args: argparse.Namespace, results: str, name: str = "study") -> str:
-    """The folder a run writes to: ``--out``, else a new temporary folder with ``--quick``, else ``results``."""
+    """The folder a run writes to: ``--out``, else a new temporary folder with ``--quick``, else ``results``.
+
+    A committed results folder from a dirty checkout is refused here, before the run
+    (:func:`~mpm_warp.studies.environment.check_provenance`: one line, exit status 1).
+    """
+    from .environment import check_provenance
+
     if args.out:
+        check_provenance(args.out)
         os.makedirs(args.out, exist_ok=True)
         return args.out
     if args.quick:
         return tempfile.mkdtemp(prefix=f"mpm_warp_{name}_quick_")
+    check_provenance(results)
     return results
 
 

@@ -49,8 +49,13 @@ def analyze_shear_series(params: ShearTestParams, calibration, times, series: di
     2.13, 2.17, 2.26, 2.45 mm) because the last column to debond sits ever closer to an end. The collapse is
     given beside two laws: ``collapse_fraction_law`` (oedometric, the debonded layer under the slab at rest) and
     ``collapse_fraction_critical_state`` (the debonded, cohesionless layer at the critical state of its final
-    mean Kirchhoff pressure ``p_final``: ``p0 = 2 p``; a sheared layer compacts more, docs/model.md §3b). The
-    calibrated layer's predictions (``calibration``, the scenario's stored
+    mean Kirchhoff pressure ``p_final``: ``p0 = 2 p``; a sheared layer compacts more, docs/model.md §3b).
+    The final pressure does not bound the collapse: once the bond is gone the load falls into the layer, its
+    mean pressure overshoots (about 1.7 ``p_final`` on the default scene) while it compacts, then unloads
+    elastically, and the compaction stays. So the law is also given at the largest mean pressure of the
+    push, ``p_max`` (Pa): ``collapse_fraction_isotropic_at_p_max`` (``p0 = p_max``, the cap's end) and
+    ``collapse_fraction_critical_state_at_p_max`` (``p0 = 2 p_max``); the layer's collapse lies between them.
+    The calibrated layer's predictions (``calibration``, the scenario's stored
     :class:`~mpm_warp.scenes.weak_layer.CalibratedWeakLayer`; :meth:`ShearTestParams.references`) are copied in.
     """
     c = shear_curves(params, times, series)
@@ -70,6 +75,12 @@ def analyze_shear_series(params: ShearTestParams, calibration, times, series: di
     cs = hardening_collapse(2.0 * p_end, mat.bulk, mat.xi, mat.p0_int_ini) \
         if np.isfinite(p_end) and p_end > 0 else math.nan
     pushed = np.asarray(times, dtype=float) >= params.push_start - 1e-12
+    p_series = np.asarray(series.get("p_kirchhoff", []), dtype=float)
+    p_max = float(np.max(p_series[pushed])) if len(p_series) == len(pushed) and pushed.any() else math.nan
+
+    def law(p0):
+        return float(hardening_collapse(p0, mat.bulk, mat.xi, mat.p0_int_ini)) \
+            if np.isfinite(p0) and p0 > 0 else math.nan
     interior = np.asarray(series.get("interior_shear_stress", []), dtype=float)
     interior = interior[pushed] if len(interior) == len(pushed) else np.array([math.nan])  # absent, or resumed
     return {"peak_shear_stress": sm.peak_stress, "residual_shear_stress": sm.residual_stress,
@@ -81,6 +92,8 @@ def analyze_shear_series(params: ShearTestParams, calibration, times, series: di
             "plate_softening_displacement": float(c["u"][k] - c["u"][ip]) if k >= 0 else math.nan,
             "bond_lost": k >= 0, "collapse_fraction": sm.collapse_fraction,
             "collapse_fraction_critical_state": float(cs), "p_final": p_end, "peak_q": float(np.max(c["q"])),
+            "p_max": p_max, "collapse_fraction_isotropic_at_p_max": law(p_max),
+            "collapse_fraction_critical_state_at_p_max": law(2.0 * p_max),
             **{f"{key}_calibrated" if key in ("delta_s", "w_f", "tau_p", "tau_peak") else key: float(v)
                for key, v in refs.items()}}
 

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from .core import section
-from .fmt import DASH, bracket, count, env_note, finite, fx, pct, ratio_range, secs, spct, table
+from .fmt import DASH, bracket, check_line, count, env_note, finite, fx, pct, ratio_range, secs, spct, table
 
 # ----------------------------------------------------------------------------- reference problems
 
@@ -38,7 +38,7 @@ def render_error_vs_runtime(data: dict, ctx) -> list[str]:
                      fx(s.get("observed_order_cfl_of_change"), 2)])
     out = table(["problem", "precision", "order in dx", "order, finest three", "slope of log error against log time",
                  f"stepping time to {pct(target, 0)} error", "at dx", "order in the CFL factor"], rows)
-    out += ["", env_note(data), "",
+    out += ["", env_note(data)] + reference_checks(data["problems"]) + ["",
             f"dx halving at CFL {fx(st.get('cfl_dx_ladder'), 1)}, {st.get('particles_per_cell_per_axis')} particles "
             f"per cell and axis; the CFL ladder ({', '.join(fx(c, 1) for c in st.get('cfl_ladder', []))}) at one dx. "
             f"Wall time: stepping only, median of {st.get('repeats')} runs, {data['environment'].get('n_threads')} "
@@ -52,6 +52,28 @@ def render_error_vs_runtime(data: dict, ctx) -> list[str]:
                      [[k, f"{r['dx']:.5g}", fx(r["cfl"], 1), f"{r['dt_mean_s']:.3g}", count(r["steps"]),
                        count(r["n_particles"]), spct(r["signed_error"], 3), f"{r['wall_time_s']:.3g}",
                        fx(r["particle_steps_per_s"], 2, 1e-6)] for k, r in lv])
+    return out
+
+
+#: The reference problems' pass line: at least first order in dx (linear shape functions; 0.9 allows the
+#: fit's scatter) and the finest level within 1 % of the exact answer
+ORDER_MIN, FINEST_ERROR_MAX = 0.9, 0.01
+
+
+def reference_checks(problems: dict) -> list[str]:
+    """The pass lines of the reference problems against their exact answers (:data:`ORDER_MIN`, ...)."""
+    orders = {n: p["summary"].get("observed_order_dx") for n, p in problems.items()}
+    finest = {n: abs(p["dx_ladder"][-1]["signed_error"]) for n, p in problems.items()
+              if p["dx_ladder"] and finite(p["dx_ladder"][-1].get("signed_error"))}
+    out = [""]
+    if orders and all(finite(o) for o in orders.values()):
+        out.append(check_line("order in dx", f"at least {fx(ORDER_MIN, 1)} in every problem",
+                              min(orders.values()) >= ORDER_MIN,
+                              ", ".join(f"`{n}` {fx(o, 2)}" for n, o in orders.items())))
+    if finest:
+        out.append(check_line("finest level against the exact answer", f"within {pct(FINEST_ERROR_MAX, 0)} in every "
+                              "problem", max(finest.values()) <= FINEST_ERROR_MAX,
+                              ", ".join(f"`{n}` {pct(e, 3)}" for n, e in finest.items())))
     return out
 
 
@@ -201,4 +223,25 @@ def render_mesh_study(data: dict, ctx) -> list[str]:
         e = [dict(zip(s["cells"], s["error"], strict=True)).get(c) for s in f64]
         if any(finite(x) for x in e):
             out.append(f"- {c} cells: {ratio_range([100 * x for x in e], 1)} %.")
+    return out + mesh_checks(data["summary"])
+
+
+#: The mesh study's pass line: from 16 cells across the layer on, every case within this of the closed form,
+#: converging at least at first order from 4 cells on (the MPM's linear shape functions)
+MESH_TOLERANCE = 0.03
+
+
+def mesh_checks(summary: list[dict]) -> list[str]:
+    """The pass lines of the mesh study against the closed form (criteria: :data:`MESH_TOLERANCE`, order 1)."""
+    fine = [(s, c, e) for s in summary for c, e in zip(s["cells"], s["error"], strict=True) if c >= 16 and finite(e)]
+    orders = [s.get("observed_order_4_cells_up") for s in summary]
+    out = [""]
+    if fine:
+        worst = max(abs(e) for _, _, e in fine)
+        out.append(check_line("collapse against the closed form", f"every case within {pct(MESH_TOLERANCE, 0)} of "
+                              "the closed form from 16 cells across the layer on", worst <= MESH_TOLERANCE,
+                              f"worst {pct(worst)}"))
+    if all(finite(o) for o in orders):
+        out.append(check_line("convergence order", "at least first order from 4 cells on in every case",
+                              min(orders) >= 1.0, f"{fx(min(orders), 2)}-{fx(max(orders), 2)}"))
     return out

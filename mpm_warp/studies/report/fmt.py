@@ -9,7 +9,7 @@ import math
 from collections.abc import Iterable, Sequence
 
 __all__ = ["finite", "fx", "pct", "spct", "count", "secs", "ratio_range", "span", "table", "env_note",
-           "environment_of", "bracket", "first"]
+           "environment_of", "bracket", "first", "check_line"]
 
 DASH = "-"
 
@@ -113,6 +113,17 @@ def environment_of(data: dict) -> dict:
 
 
 _PEERS = (("warp", "warp"), ("taichi", "Taichi"), ("weac", "weac"))
+
+
+def check_line(label: str, criterion: str, passed: bool | None, why: str = "") -> str:
+    """The pass line of a comparison with a reference, shown beside its table.
+
+    ``"- **Check, flat ladder against weac:** |MPM / weac - 1| <= 15 %: **pass** (-9.1 %)."``.
+    ``passed`` None says the comparison is open (no criterion can be judged from the data); a fail stays
+    in the document with ``why``, its explanation.
+    """
+    verdict = {True: "**pass**", False: "**FAIL**", None: "**open**"}[None if passed is None else bool(passed)]
+    return f"- **Check, {label}:** {criterion}: {verdict}" + (f" ({why})" if why else "") + "."
 
 
 def env_note(*records: dict, verb: str = "measured") -> str:

@@ -1,0 +1,141 @@
+"""Provenance of the committed results: no result from uncommitted code lands in ``benchmarks/*/results/``.
+
+The results tooling (``mpm_warp.studies.environment``) refuses to write one there; the last test lists the
+committed results that are marked dirty today and fails on any other (issue 37, part 3).
+"""
+
+from __future__ import annotations
+
+import argparse
+import glob
+import json
+import os
+import subprocess
+
+import pytest
+
+from mpm_warp.studies import environment as envmod
+from mpm_warp.studies.environment import (
+    DirtyResultError,
+    check_provenance,
+    dirty_marks,
+    git_commit,
+    is_committed_results,
+    write_json,
+)
+from mpm_warp.studies.protocol import out_dir
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _git(repo, *args):
+    subprocess.run(["git", "-C", str(repo), "-c", "user.email=t@example.org", "-c", "user.name=t", *args],
+                   check=True, capture_output=True)
+
+
+@pytest.fixture
+def repo(tmp_path):
+    """A checkout with a committed results folder, clean."""
+    r = tmp_path / "repo"
+    (r / "benchmarks" / "snow" / "results").mkdir(parents=True)
+    (r / "code.py").write_text("x = 1\n")
+    _git(r, "init", "-q")
+    _git(r, "add", "code.py")
+    _git(r, "commit", "-q", "-m", "start")
+    return r
+
+
+def test_committed_results_folders_are_recognised(tmp_path):
+    assert is_committed_results(str(tmp_path / "benchmarks" / "snow" / "results"), str(tmp_path))
+    assert is_committed_results(str(tmp_path / "benchmarks" / "snow" / "results" / "cases"), str(tmp_path))
+    assert not is_committed_results(str(tmp_path / "benchmarks" / "snow"), str(tmp_path))
+    assert not is_committed_results(str(tmp_path / "out"), str(tmp_path))
+    assert is_committed_results(os.path.join(ROOT, "benchmarks", "perf", "results"))
+
+
+def test_a_dirty_checkout_cannot_write_into_the_committed_results(repo):
+    results = str(repo / "benchmarks" / "snow" / "results")
+    check_provenance(results, None, str(repo))                     # clean: allowed
+    (repo / "code.py").write_text("x = 2\n")                       # an uncommitted change
+    assert git_commit(str(repo)).endswith("+dirty")
+    with pytest.raises(DirtyResultError) as err:
+        check_provenance(results, None, str(repo))
+    line = str(err.value)
+    assert "\n" not in line and "+dirty" in line and "commit" in line and "--out" in line
+    assert err.value.code == line                                  # SystemExit: the line, exit status 1
+    check_provenance(str(repo / "elsewhere"), None, str(repo))     # --out elsewhere: allowed
+    _git(repo, "commit", "-q", "-am", "the change")
+    check_provenance(results, None, str(repo))                     # committed: allowed again
+
+
+def test_the_recorded_commit_decides_and_nothing_is_written(repo, monkeypatch, tmp_path, capsys):
+    monkeypatch.setattr(envmod, "REPO_ROOT", str(repo))
+    results = str(repo / "benchmarks" / "snow" / "results")
+    dirty = {"environment": {"git_commit": "abc+dirty"}, "x": 1.0}
+    with pytest.raises(DirtyResultError):
+        write_json("r", dirty, results)
+    assert os.listdir(results) == []
+    merged = {"environment": {"git_commit": "abc"}, "cases": [{"git_commit_base_run": "def (+ uncommitted test file)"}]}
+    assert dirty_marks(merged) == ["def (+ uncommitted test file)"]
+    with pytest.raises(DirtyResultError):
+        write_json("r", merged, results)
+    path = write_json("r", {"environment": {"git_commit": "abc"}, "x": 1.0}, results)   # clean record: written
+    assert json.load(open(path))["x"] == 1.0
+    elsewhere = write_json("r", dirty, str(tmp_path / "mine"))                         # --out elsewhere
+    assert json.load(open(elsewhere))["environment"]["git_commit"] == "abc+dirty"
+    assert "marked dirty (abc+dirty)" in capsys.readouterr().err
+
+
+def test_a_full_run_from_a_dirty_tree_is_refused_before_it_starts(monkeypatch, tmp_path):
+    monkeypatch.setattr(envmod, "git_commit", lambda path=None: "abc+dirty")
+    results = os.path.join(ROOT, "benchmarks", "snow", "results")
+    args = argparse.Namespace(device="cpu", quick=False, out=None)
+    with pytest.raises(DirtyResultError):
+        out_dir(args, results, "x")
+    quick = out_dir(argparse.Namespace(device="cpu", quick=True, out=None), results, "x")
+    assert not is_committed_results(quick)                         # --quick still runs, to a temporary folder
+    assert out_dir(argparse.Namespace(device="cpu", quick=False, out=str(tmp_path)), results) == str(tmp_path)
+
+
+# The committed results marked dirty when the guard was added (issue 37). Each was made by code with
+# uncommitted changes, and rerunning them takes hours of CPU. This list may only shrink: rerun one from a
+# clean commit (the command beside it), commit the new JSON, and delete its line here.
+KNOWN_DIRTY = {
+    "convergence/results/error_vs_runtime_snow.json":
+        "python benchmarks/convergence/error_vs_runtime_snow.py",            # both ladders, hours
+    "field/results/field_census.json": "python benchmarks/field/census.py DIR",   # DIR: the unpacked pits
+    "perf/results/bonded_return_cost_cpu.json": "python benchmarks/perf/bonded_return_cost.py --device cpu",
+    "perf/results/pst_scaling_cpu.json": "python benchmarks/perf/pst_scaling.py",
+    "perf/results/return_cost_cpu.json": "python benchmarks/perf/return_cost.py",
+    "perf/results/throughput_cpu.json": "python benchmarks/perf/throughput.py --device cpu",
+    "robustness/results/disk_full.json": "sudo .venv/bin/python benchmarks/robustness/disk_full.py",
+    "snow/results/interface_stress_cpu.json": "python benchmarks/snow/interface_stress.py",
+    "snow/results/pst_outcomes.json": "python benchmarks/snow/pst_outcomes.py",                # ~40 min
+    "snow/results/shear_free_ends_cpu.json": "python benchmarks/snow/shear_free_ends.py",
+    "snow/results/snow_critical_cut.json":
+        "python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope",   # hours
+    "snow/results/snow_long_speed_trends.json": "python benchmarks/snow/long_speed_trends.py",   # hours
+    "snow/results/snowpack_critical_cut.json": "python benchmarks/snow/snowpack_critical_cut.py",  # hours
+}
+
+
+def test_no_new_committed_result_is_marked_dirty():
+    """No committed result may record uncommitted code (``+dirty`` or "uncommitted") unless it is in
+    ``KNOWN_DIRTY``, the explicit list of the ones that were dirty when this guard was added.
+
+    This test does not prove the committed results clean: the results in ``KNOWN_DIRTY`` are still
+    dirty until someone reruns them. It stops any new dirty result from landing, and it fails when a
+    listed one has been rerun clean but is still listed, so the list can only shrink.
+    """
+    files = glob.glob(os.path.join(ROOT, "benchmarks", "*", "results", "**", "*.json"), recursive=True)
+    assert len(files) >= 30, "the committed results were not found"
+    dirty = set()
+    for path in files:
+        with open(path) as fh:
+            text = fh.read()
+        if "+dirty" in text or "uncommitted" in text:
+            dirty.add(os.path.relpath(path, os.path.join(ROOT, "benchmarks")).replace(os.sep, "/"))
+    new = sorted(dirty - set(KNOWN_DIRTY))
+    assert not new, f"results from uncommitted code: {new}; rerun them from a clean commit"
+    rerun = sorted(set(KNOWN_DIRTY) - dirty)
+    assert not rerun, f"these are clean now: delete them from KNOWN_DIRTY: {rerun}"

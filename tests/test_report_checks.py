@@ -1,0 +1,71 @@
+"""Every comparison with a reference in docs/results.md has a pass line: its criterion and pass, FAIL or open
+(issue 37, part 2). The lines come from mpm_warp.studies.report; here their format, a fail kept with its
+explanation, and their presence in each comparing section of the committed document."""
+
+import os
+import re
+
+import pytest
+
+from mpm_warp.studies.report.fmt import check_line
+from mpm_warp.studies.report.snowpack import ends_checks, outcome_checks
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+#: the sections of docs/results.md that compare with a reference (weac, FE or closed forms, field ranges, Heierli),
+#: and how many pass lines each shows today
+COMPARING = {"Error against run time: the reference problems": 2,
+             "The weak layer's collapse under a slab: mesh study": 2,
+             "PST: `pst_flat`": 5, "PST: `pst_slope`": 5, "Critical cut": 3, "Shear test": 3,
+             "Fracture energy sweep": 2, "Crack speed against slab stiffness and collapse height": 2,
+             "Steady crack speed on 8 m columns": 3, "weac's static answers for the ladder PST": 1,
+             "Stress at the weak layer's interfaces": 1, "The three field outcomes: END, SF, ARR": 4,
+             "The snowpack's critical cut: layering and column ends": 5}
+LINE = re.compile(r"^- \*\*Check, [^*]+:\*\* .+: \*\*(pass|FAIL|open)\*\*( \(.+\))?\.$")
+
+
+def test_a_pass_line_says_its_criterion_and_keeps_a_fail_with_its_reason():
+    assert check_line("x", "within 20 %", True, "+3.6 %") == "- **Check, x:** within 20 %: **pass** (+3.6 %)."
+    assert check_line("x", "within 20 %", False, "-41.8 %: why") == \
+        "- **Check, x:** within 20 %: **FAIL** (-41.8 %: why)."
+    assert check_line("x", "the field", None, "no text") == "- **Check, x:** the field: **open** (no text)."
+
+
+def _sections(text: str) -> dict[str, str]:
+    parts = re.split(r"^### (.+)$", text, flags=re.M)
+    return dict(zip(parts[1::2], parts[2::2], strict=True))
+
+
+@pytest.mark.parametrize("title", sorted(COMPARING))
+def test_each_comparing_section_shows_its_pass_lines(title):
+    with open(os.path.join(ROOT, "docs", "results.md")) as fh:
+        sections = _sections(fh.read())
+    lines = [ln for ln in sections[title].splitlines() if ln.startswith("- **Check, ")]
+    assert len(lines) == COMPARING[title], lines
+    assert all(LINE.match(ln) for ln in lines), lines
+
+
+def _end_case(name, value, weac, ends, cut_from):
+    return {"value": value, "relative_to_weac": value / weac - 1.0, "column_ends": ends, "cut_from": cut_from,
+            "slope_angle": 35.0, "slab_layers": [{"thickness": 0.5}]}
+
+
+def test_the_column_ends_fail_on_size_with_the_wedge_and_agree_in_direction():
+    cases = {"ends_vertical_upslope": _end_case("v", 0.182, 0.3125, "vertical", "upslope"),
+             "ends_normal_upslope": _end_case("n", 0.379, 0.4816, "slope_normal", "upslope")}
+    checks = {"ends_ratio_upslope": {"mpm": 2.08, "weac": 1.54}}
+    out = ends_checks(cases, checks)
+    direction, size, field = out
+    assert "**pass**" in direction and "MPM 2.08, weac 1.54" in direction
+    assert "**FAIL**" in size and "(0 of 2)" in size and "-41.8 %" in size and "shorter than the 0.35 m wedge" in size
+    assert "**open**" in field and "Birkeland" in field
+    checks["ends_ratio_upslope"]["mpm"] = 0.9                  # the MPM on the other side of 1: a fail
+    assert "**FAIL**" in ends_checks(cases, checks)[0]
+
+
+def test_the_arrest_beyond_weacs_critical_cut_is_a_visible_fail_with_touchdown_as_its_reason():
+    arr = {"weac": {"critical_cut": 0.478, "G_c": 1.2, "energy_release_rate": 5.63},
+           "outcome": {"cut": 0.8, "arrest_at": 1.0125}}
+    start, arrest = [ln for ln in outcome_checks({"ARR": arr}) if ln]
+    assert "**pass**" in start and "ran 0.21 m beyond" in start
+    assert "**FAIL**" in arrest and "4.7 G_c" in arrest and "touchdown" in arrest and "open" in arrest
