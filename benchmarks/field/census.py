@@ -80,6 +80,17 @@ def unreadable_records(path: str) -> collections.Counter:
         return collections.Counter()
 
 
+def weak_layer_rule(choice: str) -> str:
+    """Which rule of docs/profiles.md chose a column's weak-layer thickness, from its description."""
+    if choice == "given":
+        return "given"
+    if choice.startswith("the default"):
+        return "the default 3 cm (weac's)"
+    if "taken as" in choice:
+        return "a profile layer under 1 cm, taken as 1 cm"
+    return "the profile layer's own (1-3 cm)"
+
+
 def census(files: list[str]) -> dict:
     outcome, runnable, reasons = collections.Counter(), collections.Counter(), collections.Counter()
     by_reason_outcome, examples = collections.defaultdict(collections.Counter), collections.defaultdict(list)
@@ -100,7 +111,7 @@ def census(files: list[str]) -> dict:
             outcome[r.outcome or "none"] += 1
             if isinstance(r, FieldCase):
                 runnable[r.outcome] += 1
-                choice[r.column.weak_layer_choice.split(" (")[0].split(":")[0]] += 1
+                choice[weak_layer_rule(r.column.weak_layer_choice)] += 1
                 d_wl.append(r.column.weak_layer_thickness)
                 fallback += bool(r.notes)
                 if r.fracture_energy.value is not None:

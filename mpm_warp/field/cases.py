@@ -207,7 +207,8 @@ def field_cases(path, *, base: PSTParams | None = None, calibrate: bool = True) 
     try:
         profile = read_profile(path)
     except ProfileError as e:
-        return [FieldRefusal(pit, "", "unreadable", str(e))]
+        text = str(e).replace(f"{os.fspath(path)}: ", "").replace(f"{os.fspath(path)!r}", repr(pit))
+        return [FieldRefusal(pit, "", "unreadable", text)]
     if not profile.pst_tests:
         return [FieldRefusal(pit, "", "no PST", "the profile records no PST")]
     return [field_case(profile, rec, base=base, calibrate=calibrate) for rec in profile.pst_tests]
