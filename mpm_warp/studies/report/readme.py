@@ -106,11 +106,22 @@ def _shear(ctx: Context) -> str | None:
             f"([Shear test]({_link('Shear test')})).")
 
 
+def _field(ctx: Context) -> str | None:
+    data = ctx.load("field/results/field_census.json")
+    if data is None:
+        return None
+    c = data["census"]
+    return (f"- **Real pits:** of {c['files']:,} SnowPilot pits, {c['files'] - c['files_unreadable']:,} read, and "
+            f"{c['runnable']:,} of {c['field_outcome_records']:,} End/SF/Arr PST records set up as calibrated columns "
+            f"({c['runnable_fraction_of_field_outcomes']:.1%}); each other record is refused in one line in field "
+            f"terms ([Field pits in]({_link('Field pits in')})).")
+
+
 def headlines(ctx: Context) -> list[str]:
     """The README's headline bullets (a bullet whose results are not committed is left out)."""
     out = [_throughput(ctx, "perf/results/throughput_cpu.json", 3, "Throughput beside Taichi, 3D"),
            _throughput(ctx, "perf/results/throughput_2d_cpu.json", 2, "Throughput beside Taichi, 2D"),
-           _pst_speed(ctx), _critical_cut(ctx), _slope(ctx), _shear(ctx)]
+           _pst_speed(ctx), _critical_cut(ctx), _slope(ctx), _shear(ctx), _field(ctx)]
     return [b for b in out if b]
 
 
