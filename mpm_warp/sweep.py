@@ -192,11 +192,7 @@ def _record(task: dict, status: str, error: str | None = None) -> dict:
 
 
 def _write_json(path: str, obj: dict) -> None:
-    def write(tmp):
-        with open(tmp, "w") as fh:
-            json.dump(obj, fh, indent=1, default=jsonable)
-
-    io.atomic_write(path, write, "a sweep record")
+    io.write_record(path, obj, "a sweep record", default=jsonable)
 
 
 def _n_gpus() -> int:
@@ -249,15 +245,7 @@ def _run_case(task: dict) -> dict:
 
 def _finished(task: dict) -> dict | None:
     """The record of a case finished by an earlier sweep (JSON "ok" and HDF5 readable), else None."""
-    out = os.path.join(task["out_dir"], task["id"])
-    try:
-        with open(out + ".json") as fh:
-            rec = json.load(fh)
-        if rec.get("status") == "ok" and io.read_run(out + ".h5").n_frames == rec.get("n_frames"):
-            return rec
-    except (OSError, ValueError, MPMError):
-        pass
-    return None
+    return io.finished_record(os.path.join(task["out_dir"], task["id"]))
 
 
 # ---------------------------------------------------------------------------------- the sweep

@@ -29,7 +29,7 @@ import uuid
 from dataclasses import dataclass
 
 from .. import io
-from ..errors import InvalidArgument, MPMError
+from ..errors import InvalidArgument
 from .cases import FieldCase, FieldRefusal, field_case, field_cases
 from .protocol import FieldProtocol, decided, protocol_params
 from .scores import baseline_majority, field_class, scores
@@ -83,11 +83,7 @@ def _case_id(case: FieldCase, k: int) -> str:
 
 
 def _write_json(path: str, obj: dict) -> None:
-    tmp = f"{path}.{uuid.uuid4().hex[:8]}.tmp"
-    with open(tmp, "w") as fh:
-        json.dump(obj, fh, indent=1, default=str, allow_nan=False)
-        fh.write("\n")
-    os.replace(tmp, path)
+    io.write_record(path, obj, "a field case record", default=str)
 
 
 def _finite(x):
@@ -124,15 +120,7 @@ def run_case(task: dict) -> dict:
 
 
 def _finished(task: dict) -> dict | None:
-    out = os.path.join(task["out_dir"], task["id"])
-    try:
-        with open(out + ".json") as fh:
-            rec = json.load(fh)
-        if rec.get("status") == "ok" and io.read_run(out + ".h5").n_frames == rec.get("n_frames"):
-            return rec
-    except (OSError, ValueError, MPMError):
-        pass
-    return None
+    return io.finished_record(os.path.join(task["out_dir"], task["id"]))
 
 
 def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
