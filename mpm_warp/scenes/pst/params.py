@@ -198,8 +198,12 @@ class PSTParams:
 
     def to_dict(self) -> dict:
         """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back; ``interface_closure``
-        only when on and ``saw.stop`` only when "runaway", so the files of scenes without them are unchanged)."""
+        only when on and ``saw.stop`` only when "runaway", so the files of scenes without them are unchanged;
+        the layer lists only when given: :func:`upgrade_table` refuses empty ones)."""
         d = asdict(self)
+        for key in ("slab_layers", "substratum_layers"):
+            if not d[key]:
+                del d[key]
         if not self.interface_closure:
             del d["interface_closure"]
         if self.saw.stop == "cut_length":
