@@ -149,8 +149,9 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         self.weak.load_state(entries_below(state, "weak_layer/"))
         self.base_y_ref.assign(state["base_y_ref"])
         self.base_arrival.assign(state["base_arrival"])
-        self.stopped_at = float(np.asarray(state.get("saw_stopped_at", [math.nan]), dtype=np.float64)[0])
-        self.weak.stop_blade(self.stopped_at if math.isfinite(self.stopped_at) else self.params.saw.cut_length)
+        stop = float(np.asarray(state.get("saw_stopped_at", [math.nan]), dtype=np.float64)[0])
+        self.stopped_at = stop if math.isfinite(stop) else math.nan
+        self.weak.stop_blade(stop if math.isfinite(stop) else self.params.saw.cut_length)
 
     def sawn(self) -> PSTParams:
         """The parameters of the cut made so far (:func:`.saw.sawn`): the scene's, with ``saw.cut_length`` where

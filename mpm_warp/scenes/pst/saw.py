@@ -113,9 +113,9 @@ def stop_record(params: PSTParams, stopped_at: float, runaway: float) -> dict:
     runaway : float
         The run's runaway cut (m; nan: the crack has not run away).
     """
-    out = {"saw_stopped_at": float(stopped_at)}
     if math.isfinite(stopped_at):
-        return out
+        return {"saw_stopped_at": float(stopped_at)}
+    out = {"saw_stopped_at": math.nan}       # the one nan object: records compare equal as dicts
     if params.saw.stop != "runaway":
         why = 'saw.stop = "cut_length": the blade goes to saw.cut_length'
     elif math.isfinite(runaway):
