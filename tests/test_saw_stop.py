@@ -90,6 +90,7 @@ def test_the_blade_stops_where_the_crack_ran_away(tmp_path):
     o = r["outcome"]
     assert o["class"] == "END" and r["cut_length"] == stop and r["ran_to_end"]
     assert o["saw_stopped_at"] == stop and "saw_stopped_at_null" not in o
+    assert r["weac"]["weac"] is None or r["weac"]["cut"] == stop                     # weac's answer at the cut made
     run = mw.read_run(out)
     assert run.attrs["outcome"]["pst"]["saw_stopped_at"] == stop                     # the run file records it
     assert run.scenario["scene"]["saw"]["stop"] == "runaway"

@@ -179,7 +179,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
                           self.deflection_arrival())
         out.update(stop_record(self.params, self.stopped_at, out["runaway_cut"]))
         out["outcome"] = self._classify(times, series, out["runaway_cut"])
-        out["weac"] = weac_answer(self.params, self.calibration)
+        out["weac"] = weac_answer(made, self.calibration)       # weac's answer at the cut made
         return out
 
     def outcome(self) -> dict:
