@@ -9,7 +9,7 @@ import time
 import numpy as np
 import pytest
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
-from helpers_scenes import TINY_PST, assert_same_series
+from helpers_scenes import RUNNING_PST, TINY_PST, assert_same_series
 
 import mpm_warp as mw
 from mpm_warp import io
@@ -139,6 +139,19 @@ def test_pst_interrupted_after_settling_resumes_bit_for_bit(tmp_path):
     np.testing.assert_array_equal(full.monitor.weak.arrival.numpy(), res.monitor.weak.arrival.numpy())
     np.testing.assert_array_equal(full.monitor.weak.ref.numpy(), res.monitor.weak.ref.numpy())
     np.testing.assert_array_equal(full.monitor.base_arrival.numpy(), res.monitor.base_arrival.numpy())
+
+
+def test_pst_resumed_after_the_saw_stopped_on_runaway_keeps_the_stop(tmp_path):
+    """saw.stop = "runaway": the blade stops near 0.18 m at 0.22 s; stopped at 0.25 s and resumed, the blade stays
+    there (it would go on to 0.5 m) and the run is the uninterrupted one, bit for bit."""
+    over = RUNNING_PST + ["scene.saw.cut_length=0.5", "scene.saw.stop=runaway", "time.end=0.3",
+                          "output.checkpoint_every=1"]
+    full, res, arrays = _interrupted_equals_uninterrupted(tmp_path, "pst_demo", over, 0.25, ["saw_stopped_at"])
+    stop = arrays["monitors/pst/device/saw_stopped_at"][0]
+    assert 0.1 < stop < 0.3 and stop == full.monitor.stopped_at == res.monitor.stopped_at
+    assert float(res.monitor.weak.blade_end.numpy()[0]) == stop
+    np.testing.assert_array_equal(full.monitor.weak.sawn.numpy(), res.monitor.weak.sawn.numpy())
+    assert res.scene_result["saw_stopped_at"] == stop
 
 
 def test_shear_test_interrupted_while_pushing_resumes_bit_for_bit(tmp_path):

@@ -37,6 +37,7 @@ import numpy as np
 import mpm_warp as mw
 from mpm_warp.scenes.front_speed import NUCLEATION
 from mpm_warp.scenes.pst.analysis import rederive_speeds
+from mpm_warp.scenes.pst.saw import sawn
 from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, git_commit, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -88,7 +89,8 @@ def reanalyse(name: str, folder: str) -> str:
     with open(os.path.join(RESULTS, f"snow_{name}.json")) as fh:
         res = json.load(fh)
     sc = mw.load_scenario(res["scenario"], res["overrides"])
-    r, p = res["result"], sc.scene
+    r = res["result"]
+    p = sawn(sc.scene, _nan([r.get("saw_stopped_at")])[0])     # a saw stopped on runaway: the cut it made
     stored = (r["cut_length"], r["column_length"], r["shear_wave_speed"])
     today = (float(p.saw.cut_length), float(p.length), p.equivalent_slab().material().s_wave_speed)
     if not all(math.isclose(a, b, rel_tol=1e-9) for a, b in zip(stored, today, strict=True)):

@@ -14,12 +14,12 @@ from ..io import RunData
 from ..loader import scene_params_from_dict
 from ..scenes.front_speed import NUCLEATION
 from ..scenes.fronts import fit_window, steady_speed
-from ..scenes.pst import PSTParams
+from ..scenes.pst import PSTParams, sawn
 from ..scenes.pst.analysis import MEAN_SPEED_DISTANCE, end_zone, slab_p_wave_speed
 from ..scenes.weak_layer import CalibratedWeakLayer
 
-__all__ = ["scene_params", "scene_calibration", "front_name", "fit_front_speed", "front_speed", "front_and_saw_x",
-           "fronts_x"]
+__all__ = ["scene_params", "sawn_params", "scene_calibration", "front_name", "fit_front_speed", "front_speed",
+           "front_and_saw_x", "fronts_x"]
 
 
 def scene_params(run: RunData):
@@ -31,6 +31,16 @@ def scene_params(run: RunData):
         return scene_params_from_dict({k: v for k, v in table.items() if k != "derived"}, run.path)
     except MPMError:                  # a file of another version: the generic analyses still work
         return None
+
+
+def sawn_params(run: RunData):
+    """:func:`scene_params`, for a PST whose saw stopped on the crack's runaway those of the cut made
+    (:func:`~mpm_warp.scenes.pst.sawn`: ``saw.cut_length`` where it stopped, the run file's ``saw_stopped_at``)."""
+    params = scene_params(run)
+    if not isinstance(params, PSTParams):
+        return params
+    stopped = ((run.attrs.get("outcome") or {}).get("pst") or {}).get("saw_stopped_at")
+    return sawn(params, float(stopped)) if isinstance(stopped, (int, float)) else params
 
 
 def scene_calibration(run: RunData, params=None):
@@ -104,7 +114,7 @@ def front_speed(run: RunData) -> dict:
     if name is None:
         raise InvalidArgument("run", run.path, "a run with a front series (front_position or a PST's front)")
     t, xf = run.times, run.scalars[name]
-    params = scene_params(run)
+    params = sawn_params(run)
     if name == "front" and isinstance(params, PSTParams):
         start = float(params.saw.cut_length) + params.bin_width      # beyond the cut: the saw's own path left out
         end = min(start - params.bin_width + MEAN_SPEED_DISTANCE, float(params.length) - end_zone(params))

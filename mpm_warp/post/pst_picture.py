@@ -24,7 +24,7 @@ from ..errors import InvalidArgument
 from ..io import RunData, read_run
 from ..scenes.pst import PSTParams
 from ..scenes.pst.analysis import end_zone
-from .fronts import scene_calibration, scene_params
+from .fronts import sawn_params, scene_calibration
 
 __all__ = ["pst_picture", "running_frame"]
 
@@ -76,7 +76,7 @@ def pst_picture(path, out_png: str, frame: int | None = None, exaggeration: floa
     from matplotlib.figure import Figure
 
     run = path if isinstance(path, RunData) else read_run(path)
-    params = scene_params(run)
+    params = sawn_params(run)               # a saw stopped on runaway: the cut it made
     if not isinstance(params, PSTParams):
         raise InvalidArgument("path", run.path, "a PST run file (scene kind 'pst')")
     missing = [f for f in ("x", "log_jp", "log_jp_ref") if f not in run.particle_fields]

@@ -17,6 +17,10 @@ Run sequence (all on the device, no host loop):
    bond (a kerf), is cohesionless and collapses under the slab;
 3. free run: the crack runs by itself or arrests.
 
+With ``saw.stop = "runaway"`` (the field protocol, :mod:`.saw`) the blade stops where it is at the first frame
+the crack has run away from it, so that what follows is the crack's own; a crack that never runs away before
+the blade reaches ``saw.cut_length`` is "no propagation" (NP, :mod:`.outcome`).
+
 Fronts (documented criteria, distances from the saw's end of the column, m; bins of ``front.bin``):
 
 - damage front: a weak-layer particle is damaged once its bond ``1 - kappa/kappa_s`` has fallen to
@@ -34,7 +38,8 @@ Resolution: the weak layer must span at least three grid cells
 (:data:`~mpm_warp.scenes.snow.MIN_WEAK_LAYER_CELLS`: the stencils of the slab and the substratum must not
 share a grid node); four resolve it (the ready scenes).
 
-Modules: :mod:`.params` (:class:`PSTParams` and its derived values), :mod:`.build`,
+Modules: :mod:`.params` (:class:`PSTParams` and its derived values), :mod:`.saw` (the saw, the front
+criteria and the cut made by a saw that stopped on runaway), :mod:`.build`,
 :mod:`.kernels` (the deflection tracker; the saw is the weak layer's), :mod:`.monitor`
 (:class:`PSTMonitor`), :mod:`.analysis` (:func:`pst_summary`), :mod:`.critical` (:func:`critical_cut`:
 bisection over trial runs forked from one base run); the closed forms in
@@ -49,10 +54,11 @@ from .build import build
 from .critical import CriticalCut, critical_cut, cut_run
 from .from_profile import ProfileSource, expand_profile
 from .monitor import PSTMonitor, attach
-from .params import ColumnEnds, CutFrom, Front, PSTParams, Saw, upgrade_table
+from .params import ColumnEnds, CutFrom, Front, PSTParams, Saw, SawStop, upgrade_table
+from .saw import sawn
 
-__all__ = ["SCENE", "PSTParams", "Saw", "Front", "CutFrom", "ColumnEnds", "ProfileSource", "expand_profile",
-           "build", "attach", "PSTMonitor",
+__all__ = ["SCENE", "PSTParams", "Saw", "SawStop", "sawn", "Front", "CutFrom", "ColumnEnds", "ProfileSource",
+           "expand_profile",           "build", "attach", "PSTMonitor",
            "pst_summary", "critical_cut", "cut_run", "CriticalCut", "heierli_speed", "heierli_touchdown",
            "critical_cut_length_formula"]
 

@@ -6,6 +6,10 @@ slab-deflection front (the slab base coming down). No speed exceeds the slab's P
 seems faster connected to damage ahead of it, which is reported as such
 (:mod:`mpm_warp.scenes.front_speed`). A value that does not exist (a crack that did not run has no speed) is
 nan here with its reason under ``<key>_null``; the results files write it as null.
+
+The parameters these functions take are those of the cut made (:func:`~.saw.sawn`): a saw that stopped on the
+crack's runaway (``saw.stop = "runaway"``) is a saw set to cut where it stopped, and the blade's position is
+recomputed from its speed and the time up to there (:func:`~.saw.blade_position`).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from ..front_speed import JUMP_FRACTION, bounded_mean_speed, damage_ahead, path_
 from ..fronts import front_trajectory, lead_ahead_of_front
 from ..references import heierli_speed, heierli_touchdown
 from .params import PSTParams
+from .saw import blade_position
 
 __all__ = ["pst_summary", "front_speeds", "rederive_speeds", "end_zone", "runaway_cut", "slab_p_wave_speed",
            "crack_ran", "SPEED_WINDOW", "MEAN_SPEED_DISTANCE", "SPEED_LIMIT_DISTANCE"]
@@ -87,9 +92,13 @@ def _front(params: PSTParams, s, t_arrival, prefix: str) -> dict:
 
 
 def runaway_cut(params: PSTParams, s, t_arrival) -> float:
-    """Saw position (m) when the damage front first led the blade by ``front.runaway_lead``; nan if never."""
+    """Saw position (m) when the damage front first led the blade by ``front.runaway_lead``; nan if never.
+
+    ``s`` are the bin centres (m from the cut end), ``t_arrival`` their damage times (s, inf: never); the blade's
+    position is :func:`~.saw.blade_position` of ``params``, the cut made (:func:`~.saw.sawn`).
+    """
     sp, T = front_trajectory(s, t_arrival)
-    saw = np.clip(params.saw.speed * (T - params.saw_start), 0.0, params.saw.cut_length)
+    saw = blade_position(params, T)
     k = np.nonzero(sp - saw >= params.front.runaway_lead)[0]
     return float(saw[k[0]]) if len(k) else math.nan
 
@@ -148,6 +157,7 @@ def pst_summary(params: PSTParams, calibration, times, series: dict, s_bins, t_d
     Parameters
     ----------
     params : PSTParams
+        The parameters of the cut made (:func:`~.saw.sawn`); ``cut_length`` in the result is its cut (m).
     calibration : CalibratedWeakLayer
         The weak layer's calibration (the scenario's stored one), for the references.
     times : array (n,)

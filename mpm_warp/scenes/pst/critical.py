@@ -148,6 +148,9 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
     p = scenario.scene
     if not isinstance(p, PSTParams):
         raise TypeError("critical_cut needs a PST scenario (scene kind 'pst')")
+    if p.saw.stop != "cut_length":
+        raise ValueError(f"critical_cut bisects on the cut length: need saw.stop = 'cut_length' (got {p.saw.stop!r}; "
+                         "a saw that stops on runaway estimates the critical cut from one run: runaway_cut)")
     if not 0.0 <= lo < hi <= p.length:
         raise ValueError(f"need 0 <= lo < hi <= length (got lo={lo}, hi={hi}, length={p.length})")
     if workers not in (1, 2):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import warp as wp
 
@@ -13,6 +15,7 @@ from .build import layer_names
 from .kernels import deflection_kernel
 from .outcome import SlabCrackDetector, classify
 from .params import PSTParams
+from .saw import blade_position, sawn, stop_record
 from .static import weac_answer
 
 __all__ = ["PSTMonitor", "attach"]
@@ -30,12 +33,22 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
     deflection front where the slab base reaches 95 % of its collapsed deflection; nan before the crack
     runs), ``marker{k}_ux``/``marker{k}_uy`` (m, displacement since t = 0 of the slab-base particle
     nearest to ``params.markers()[k]``).
+    With ``saw.stop = "runaway"`` the monitor stops the blade where it is at the first frame the crack has run
+    away from it (:func:`~.analysis.runaway_cut` of the arrival times so far is finite) by writing its position
+    into the saw kernel's blade end (:attr:`stopped_at`, m from the cut end); the blade overshoots the runaway
+    by at most one frame interval times the saw speed.
     Per-frame particle field (with ``log_jp`` in the output): ``log_jp_ref``, the collapse reference.
 
     Parameters
     ----------
     sim : Simulation
         Built from a PST scenario (``sim.scenario.scene`` a :class:`PSTParams`).
+
+    Attributes
+    ----------
+    stopped_at : float
+        Where the blade stopped on the crack's runaway (m from the cut end), nan while it has not (and always
+        with ``saw.stop = "cut_length"``).
     """
 
     name = "pst"
@@ -51,6 +64,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         left = p.cut_at_origin
         saw = (p.saw_start, p.saw.speed, p.saw.cut_length, 0.0 if left else float(p.length), 1.0 if left else -1.0)
         self.weak = WeakLayerTracker(sim, "weak_layer", p.saw_start, saw)
+        self.stopped_at = math.nan
         self.calibration = stored_calibration(sim.scenario)
         self.h_c = self.calibration.h_c
         self.s_weak = p.distance_from_cut_end(self.weak.group.x0[:, 0])
@@ -101,8 +115,11 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         t = sim.time
         p = self.params
         bin_w = p.bin_width
+        arrival = self.damage_arrival()
+        self._stop_on_runaway(t, arrival)
+        cut = self.sawn().saw.cut_length
         deflection = self.deflection_front(t)
-        out = {"front": self.damage_front(t),
+        out = {"front": min(front_from_arrival(arrival, t, bin_w), float(p.length)),
                "deflection_front": deflection, "saw": self.saw_position(t)}
         if self.slab_crack is not None:
             out["slab_crack"] = self.slab_crack.through_crack()
@@ -111,8 +128,8 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         out["collapse_height"] = float(np.mean(c[gone]) * p.weak_layer_thickness) if gone.any() else 0.0
         y = self.slab.x.numpy()[self.base_index, 1].astype(np.float64)
         w = self.base_y_ref.numpy() - y
-        out["touchdown"] = touchdown_distance(self.s_base, w, deflection, s_min=p.saw.cut_length) \
-            if deflection > p.saw.cut_length + 4.0 * bin_w else float("nan")
+        out["touchdown"] = touchdown_distance(self.s_base, w, deflection, s_min=cut) \
+            if deflection > cut + 4.0 * bin_w else float("nan")
         u = self.slab.x.numpy()[self.marker_index].astype(np.float64) - self.slab.x0[self.marker_index]
         for k in range(len(self.markers)):
             out[f"marker{k}_ux"] = float(u[k, 0])
@@ -120,31 +137,61 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         return out
 
     def device_state(self) -> dict[str, np.ndarray]:
-        """Weak-layer reference, saw flags and damage times; slab-base reference and deflection times."""
+        """Weak-layer reference, saw flags and damage times; slab-base reference and deflection times; where the
+        blade stopped on runaway (``saw_stopped_at``, m, nan: it did not)."""
         return {**{f"weak_layer/{k}": v for k, v in self.weak.state().items()},
-                "base_y_ref": self.base_y_ref.numpy(), "base_arrival": self.base_arrival.numpy()}
+                "base_y_ref": self.base_y_ref.numpy(), "base_arrival": self.base_arrival.numpy(),
+                "saw_stopped_at": np.array([self.stopped_at], dtype=np.float64)}
 
     def load_device_state(self, state: dict[str, np.ndarray]) -> None:
-        """Restore :meth:`device_state`."""
+        """Restore :meth:`device_state`; the blade's end is this scene's cut unless the state's blade had stopped
+        (a checkpoint of an older release has no stop: the blade goes on to the cut)."""
         self.weak.load_state(entries_below(state, "weak_layer/"))
         self.base_y_ref.assign(state["base_y_ref"])
         self.base_arrival.assign(state["base_arrival"])
+        stop = float(np.asarray(state.get("saw_stopped_at", [math.nan]), dtype=np.float64)[0])
+        self.stopped_at = stop if math.isfinite(stop) else math.nan
+        self.weak.stop_blade(stop if math.isfinite(stop) else self.params.saw.cut_length)
+
+    def sawn(self) -> PSTParams:
+        """The parameters of the cut made so far (:func:`.saw.sawn`): the scene's, with ``saw.cut_length`` where
+        the blade stopped once it stopped on runaway."""
+        return sawn(self.params, self.stopped_at)
+
+    def _stop_on_runaway(self, t: float, arrival: np.ndarray) -> None:
+        """With ``saw.stop = "runaway"``: stop the blade where it is at ``t`` (s) once the damage front (bin
+        arrival times ``arrival``, s) has led it by ``front.runaway_lead`` (:func:`~.analysis.runaway_cut`)."""
+        p = self.params
+        if p.saw.stop != "runaway" or math.isfinite(self.stopped_at):
+            return
+        blade = float(blade_position(p, t))
+        if blade >= p.saw.cut_length or not math.isfinite(runaway_cut(p, self.bin_centres(), arrival)):
+            return                      # at its end already (it stays there), or no runaway yet
+        self.weak.stop_blade(blade)
+        self.stopped_at = blade
 
     def result(self) -> dict:
-        """Scene results from the series and arrival times so far (:func:`.analysis.pst_summary`)."""
+        """Scene results from the series and arrival times so far (:func:`.analysis.pst_summary` of the cut made,
+        :meth:`sawn`), with ``saw_stopped_at`` (m, :func:`.saw.stop_record`), the ``outcome`` and ``weac``."""
         times, series = self.series_arrays()
-        out = pst_summary(self.params, self.calibration, times, series, self.bin_centres(), self.damage_arrival(),
+        made = self.sawn()
+        out = pst_summary(made, self.calibration, times, series, self.bin_centres(), self.damage_arrival(),
                           self.deflection_arrival())
-        out["outcome"] = classify(self.params, times, series.get("front", []), series.get("slab_crack"),
-                                  out["runaway_cut"])
-        out["weac"] = weac_answer(self.params, self.calibration)
+        out.update(stop_record(self.params, self.stopped_at, out["runaway_cut"]))
+        out["outcome"] = self._classify(times, series, out["runaway_cut"])
+        out["weac"] = weac_answer(made, self.calibration)       # weac's answer at the cut made
         return out
 
     def outcome(self) -> dict:
-        """How the run ended, as the field writes it (:func:`~.outcome.classify`): stored in the run file."""
+        """How the run ended, as the field writes it (:func:`~.outcome.classify` of the cut made), with
+        ``saw_stopped_at`` (m; null with its reason when the blade did not stop on runaway): in the run file."""
         times, series = self.series_arrays()
-        runaway = runaway_cut(self.params, self.bin_centres(), self.damage_arrival())
-        return classify(self.params, times, series.get("front", []), series.get("slab_crack"), runaway)
+        return self._classify(times, series, runaway_cut(self.sawn(), self.bin_centres(), self.damage_arrival()))
+
+    def _classify(self, times, series: dict, runaway: float) -> dict:
+        out = classify(self.sawn(), times, series.get("front", []), series.get("slab_crack"), runaway)
+        out.update(stop_record(self.params, self.stopped_at, runaway))
+        return out
 
     # ------------------------------------------------------------------ queries
     def bin_centres(self) -> np.ndarray:
@@ -173,9 +220,8 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         return min(front_from_arrival(self.deflection_arrival(), t, p.bin_width), float(p.length))
 
     def saw_position(self, t: float) -> float:
-        """Blade distance from the cut end (m) at time ``t`` (s)."""
-        p = self.params
-        return float(np.clip(p.saw.speed * (t - p.saw_start), 0.0, p.saw.cut_length))
+        """Blade distance from the cut end (m) at time ``t`` (s), stopped where it stopped on runaway."""
+        return float(blade_position(self.sawn(), t))
 
 
 def attach(sim) -> PSTMonitor:

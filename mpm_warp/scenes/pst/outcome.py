@@ -1,10 +1,18 @@
-"""The outcome of a PST as the field writes it: END, SF or ARR, and the line ``PST 32/100 (END) down 50 cm``.
+"""The outcome of a PST as the field writes it: END, SF or ARR (or NP), and the line ``PST 32/100 (END) down 50 cm``.
 
 The field's three classes (e.g. Greene et al., SWAG; Gauthier and Jamieson 2008):
 
 - END: the crack in the weak layer reached the far end of the column;
 - SF: the slab fractured through before that;
-- ARR: the crack arrested in the weak layer (here also a crack that never ran beyond the saw).
+- ARR: the crack arrested in the weak layer (here also a crack that never ran beyond the saw, with
+  ``saw.stop = "cut_length"``).
+
+With the field protocol (``saw.stop = "runaway"``: the saw stops once the crack runs away from it) a fourth:
+
+- NP, no propagation: the blade reached the end it may go to, ``saw.cut_length`` (the column's end for a
+  field test), without the crack running away from it, and the front stands still; counted apart from an
+  ARR, a crack that ran away and then stopped. A slab that broke only after the blade reached its end is
+  noted, not an SF.
 
 A through-crack of the slab (:class:`SlabCrackDetector`): in a window one slab thickness wide along the
 column, the fully damaged slab particles (damage >= :data:`THROUGH_DAMAGE`) cover at least
@@ -22,7 +30,10 @@ import numpy as np
 from .analysis import crack_ran, end_zone
 from .params import PSTParams
 
-__all__ = ["SlabCrackDetector", "classify", "field_line", "THROUGH_DAMAGE", "THROUGH_COVER", "STALL_TIME"]
+__all__ = ["SlabCrackDetector", "classify", "field_line", "CLASSES", "THROUGH_DAMAGE", "THROUGH_COVER", "STALL_TIME"]
+
+#: the classes of :func:`classify`: the field's three and no propagation (``saw.stop = "runaway"`` only)
+CLASSES = ("END", "SF", "ARR", "NP")
 
 #: damage (-) at which a slab particle is cracked through
 THROUGH_DAMAGE = 0.95
@@ -95,18 +106,22 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
     Parameters
     ----------
     params : PSTParams
+        The parameters of the cut made (:func:`~.saw.sawn`: ``saw.cut_length`` where the blade stopped when it
+        stopped on runaway).
     times, front : array (n,)
         Frame times (s) and the damage front (m from the cut end).
     slab_crack : array (n,), optional
         Position of a through-crack of the slab per frame (m, nan: none); None for a slab that cannot break.
     saw_cut : float, optional
         The cut the field line quotes (m): the saw's position when the crack ran away from it (the run's
-        ``runaway_cut``) or, when it never did, the cut made (``saw.cut_length``).
+        ``runaway_cut``) or, when it never did, the cut made (``saw.cut_length``). With ``saw.stop = "runaway"``
+        a nan or None is no runaway: NP once the blade reached its end and the front stands still.
 
     Returns
     -------
     dict
-        ``class`` ("END", "SF", "ARR", or None while the crack still runs when the series ends),
+        ``class`` ("END", "SF", "ARR", "NP" (``saw.stop = "runaway"``, no runaway before the blade's end), or
+        None while the crack still runs when the series ends),
         ``field_line`` (:func:`field_line`), ``cut``, ``column_length``, ``depth`` (m, vertical: the slab's
         bed-normal thickness over the cosine of the slope), ``end_time``,
         ``slab_fracture_time`` (s, nan: never), ``slab_fracture_at`` (m from the cut end, nan), ``arrest_at``
@@ -124,11 +139,18 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
     at_sf = float(sc[broke[0]]) if len(broke) else math.nan
     out = {"cut": cut, "column_length": L, "depth": D, "end_time": t_end, "slab_fracture_time": t_sf,
            "slab_fracture_at": math.nan, "arrest_at": math.nan, "note": ""}
-    if math.isfinite(t_sf) and not t_end <= t_sf:
+    no_runaway = params.saw.stop == "runaway" and (saw_cut is None or not math.isfinite(saw_cut))
+    if math.isfinite(t_sf) and not t_end <= t_sf and not (no_runaway and t_sf > params.saw_end):
         cls = "SF"
         out["slab_fracture_at"] = at_sf
     elif math.isfinite(t_end):
         cls = "END"
+    elif no_runaway and len(t) and _stalled(t, fr, params):
+        cls = "NP"
+        out["note"] = (f"the saw reached its end, {float(params.saw.cut_length):.2f} m, without the crack running "
+                       f"away from it by {params.front.runaway_lead:g} m")
+        if math.isfinite(t_sf):
+            out["note"] += f"; the slab then broke {at_sf:.2f} m from the cut end"
     elif len(t) and _stalled(t, fr, params):
         cls = "ARR"
         out["arrest_at"] = float(fr[-1])

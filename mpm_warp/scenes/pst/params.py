@@ -24,58 +24,12 @@ from ..snow import (
 from ..snowpack import SnowLayer, check_stack, equivalent_slab, stack_normal_stress, stack_thickness
 from ..weak_layer import CalibratedWeakLayer, WeakLayer
 from .from_profile import ProfileSource
+from .saw import CutFrom, Front, Saw, SawStop
 
-__all__ = ["Saw", "Front", "PSTParams", "ColumnEnds", "CutFrom", "upgrade_table"]
+__all__ = ["Saw", "Front", "PSTParams", "ColumnEnds", "CutFrom", "SawStop", "upgrade_table"]
 
-#: where the saw starts: the column's upslope or downslope end (on flat ground "upslope" is the end x = 0)
-CutFrom = Literal["upslope", "downslope"]
 #: the column's end faces: normal to the slope (European practice) or vertical (the North American standard)
 ColumnEnds = Literal["slope_normal", "vertical"]
-
-
-@dataclass(frozen=True)
-class Saw:
-    """The saw: a blade advancing through the weak layer from one end of the column after settling.
-
-    Behind the blade the weak layer loses its bond (a kerf): cohesionless, it collapses under the
-    slab as a debonded layer does (:mod:`mpm_warp.scenes.weak_layer`).
-
-    Attributes
-    ----------
-    speed : float
-        Blade speed (m/s), in (0, 1]: a saw is slow against the crack (field saws: 0.1-0.5 m/s).
-    cut_length : float
-        Length of the cut (m), in [0, length], along the weak layer from the end it starts at: where the
-        blade stops.
-    cut_from : {"upslope", "downslope"}
-        The end of the column it starts from. ``x`` runs downslope, so on a slope of positive angle the
-        upslope end is ``x = 0``; on flat ground "upslope" names the end ``x = 0``.
-    """
-
-    speed: float = 1.0
-    cut_length: float = 0.6
-    cut_from: CutFrom = "upslope"
-
-
-@dataclass(frozen=True)
-class Front:
-    """The front criteria (see :mod:`mpm_warp.scenes.pst`).
-
-    Attributes
-    ----------
-    bin : float
-        Bin width along the column (m); 0 = the grid spacing.
-    deflection : float
-        The slab-deflection front: the slab base has come down by this fraction of the collapse
-        height ``h_c`` (-), in (0, 1].
-    runaway_lead : float
-        The crack runs away from the saw once the damage front leads the blade by this (m), > 0:
-        the saw position then estimates the critical cut from one run.
-    """
-
-    bin: float = 0.0
-    deflection: float = 0.1
-    runaway_lead: float = 0.3
 
 
 @dataclass(frozen=True)
@@ -244,10 +198,16 @@ class PSTParams:
 
     def to_dict(self) -> dict:
         """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back; ``interface_closure``
-        only when on, so the files of scenes without it are unchanged)."""
+        only when on and ``saw.stop`` only when "runaway", so the files of scenes without them are unchanged;
+        the layer lists only when given: :func:`upgrade_table` refuses empty ones)."""
         d = asdict(self)
+        for key in ("slab_layers", "substratum_layers"):
+            if not d[key]:
+                del d[key]
         if not self.interface_closure:
             del d["interface_closure"]
+        if self.saw.stop == "cut_length":
+            del d["saw"]["stop"]
         return d
 
     # ------------------------------------------------------------- the snowpack
@@ -321,7 +281,8 @@ class PSTParams:
 
     @property
     def saw_end(self) -> float:
-        """Time the saw stops (s)."""
+        """Time the saw reaches ``saw.cut_length`` (s): where it stops unless it stopped on runaway before
+        (:func:`.saw.sawn` gives the parameters of the cut made)."""
         return self.saw_start + self.saw.cut_length / self.saw.speed
 
     @property

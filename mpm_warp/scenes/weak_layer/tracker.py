@@ -48,7 +48,8 @@ class WeakLayerTracker:
     t_ref : float
         End of settling (s): the collapse reference is the state then.
     saw : (t_start, speed, cut_length, x_start, direction) or None
-        The saw (s, m/s, m, m, +1/-1), or none (shear test).
+        The saw (s, m/s, m, m, +1/-1), or none (shear test). ``cut_length`` is the blade's end to begin with
+        (:attr:`blade_end`; :meth:`stop_blade` moves it between frames).
 
     Attributes
     ----------
@@ -60,6 +61,9 @@ class WeakLayerTracker:
         1 behind the saw.
     arrival : wp.array of float64 (n,)
         Damage time (s) of each particle, inf while its bond is above :data:`DAMAGE_BOND`.
+    blade_end : wp.array of float64 (1,)
+        Where the blade stops (m from ``x_start``), read by the saw kernel every step: ``cut_length`` until
+        :meth:`stop_blade` writes it.
     """
 
     def __init__(self, sim, group_name: str, t_ref: float, saw=None):
@@ -75,10 +79,11 @@ class WeakLayerTracker:
         self.sawn = wp.zeros(view.count, dtype=wp.uint8, device=sim.device)
         self.arrival = wp.full(view.count, np.inf, dtype=wp.float64, device=sim.device)
         t_saw, speed, cut, x_start, direction = saw if saw is not None else (math.inf, 0.0, 0.0, 0.0, 1.0)
+        self.blade_end = wp.array([float(cut)], dtype=wp.float64, device=sim.device)
         self.launch = wp.launch(
             weak_layer_kernel(sim.model.dim, T), view.count,
             inputs=[view.x, self.log_jp, self.kappa, self.ref, self.sawn, self.arrival, sim.clock, float(t_ref),
-                    T(m.kappa_s), T(DAMAGE_BOND), float(t_saw), float(speed), float(cut), float(x_start),
+                    T(m.kappa_s), T(DAMAGE_BOND), float(t_saw), float(speed), self.blade_end, float(x_start),
                     float(direction)],
             device=sim.device, record_cmd=True)
 
@@ -96,8 +101,14 @@ class WeakLayerTracker:
         the median of its particles' damage times (inf: not damaged yet)."""
         return bin_median(s0, self.arrival.numpy(), bin_width, n_bins)
 
+    def stop_blade(self, position: float) -> None:
+        """Stop the blade at ``position`` (m from ``x_start``): a copy into :attr:`blade_end`, between frames
+        (the steps queued after it, graphs included, read it)."""
+        self.blade_end.assign(np.array([float(position)], dtype=np.float64))
+
     def state(self) -> dict[str, np.ndarray]:
-        """Checkpoint state: ``ref``, ``sawn`` and ``arrival``."""
+        """Checkpoint state: ``ref``, ``sawn`` and ``arrival`` (the blade's end is the scene monitor's: a trial
+        forked from another run's snapshot keeps its own cut)."""
         return {"ref": self.ref.numpy(), "sawn": self.sawn.numpy(), "arrival": self.arrival.numpy()}
 
     def load_state(self, state: dict[str, np.ndarray]) -> None:
