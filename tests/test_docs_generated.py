@@ -1,5 +1,5 @@
 """The command-line and scenario key references in docs/scenarios.md and the README's command table are
-generated from the code (``python -m mpm_warp.studies.report.docs``): the committed files are current, and
+generated from the code (``python -m mpm_warp.docgen``): the committed files are current, and
 the generators read what the code says (every flag, every field, the ranges the checks enforce)."""
 
 from __future__ import annotations
@@ -11,12 +11,12 @@ import os
 import pytest
 
 from mpm_warp.cli import build_parser
+from mpm_warp.docgen import generated_files, main
+from mpm_warp.docgen.cli_doc import cli_lines, readme_lines, subcommands
+from mpm_warp.docgen.dataclass_doc import check_ranges, field_docs
+from mpm_warp.docgen.keys_doc import keys_lines
 from mpm_warp.scenes.pst import PSTParams
 from mpm_warp.scenes.pst.params import Saw
-from mpm_warp.studies.report.cli_doc import cli_lines, readme_lines, subcommands
-from mpm_warp.studies.report.dataclass_doc import check_ranges, field_docs
-from mpm_warp.studies.report.docs import generated_files, main
-from mpm_warp.studies.report.keys_doc import keys_lines
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -25,7 +25,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 def test_committed_generated_blocks_are_current(rel):
     old, new = generated_files(ROOT)[rel]
     diff = "\n".join(list(difflib.unified_diff(old.splitlines(), new.splitlines(), lineterm="", n=1))[:30])
-    assert old == new, f"{rel} is out of date: run `python -m mpm_warp.studies.report.docs` and commit\n{diff}"
+    assert old == new, f"{rel} is out of date: run `python -m mpm_warp.docgen` and commit\n{diff}"
 
 
 def test_check_mode_reports_a_stale_file(tmp_path):

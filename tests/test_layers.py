@@ -43,7 +43,7 @@ def layer(module: str) -> int:
         return LAYERS.index("field")
     if top == "studies":
         return LAYERS.index("studies")
-    if top in ("cli", "cli_field", "sweep", "sweep_summary"):
+    if top in ("cli", "cli_field", "docgen", "sweep", "sweep_summary"):
         return LAYERS.index("CLI and sweeps")
     return LAYERS.index("engine")
 

@@ -14,12 +14,9 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from .params import PSTParams
 
 __all__ = ["Saw", "Front", "CutFrom", "SawStop", "sawn", "blade_position", "stop_record"]
 
@@ -82,8 +79,9 @@ class Front:
     runaway_lead: float = 0.3
 
 
-def sawn(params: PSTParams, stopped_at: float = math.nan) -> PSTParams:
-    """The parameters of the cut made: ``params`` with ``saw.cut_length`` the blade's stop ``stopped_at`` (m from
+def sawn(params, stopped_at: float = math.nan):
+    """The parameters of the cut made: ``params`` (a :class:`~.params.PSTParams`, which imports this module) with
+    ``saw.cut_length`` the blade's stop ``stopped_at`` (m from
     the cut end) when it stopped on runaway (finite), ``params`` itself otherwise.
 
     The blade's history is that of a saw set to cut ``stopped_at``, so the analyses that recompute it from its
@@ -94,13 +92,13 @@ def sawn(params: PSTParams, stopped_at: float = math.nan) -> PSTParams:
     return dataclasses.replace(params, saw=dataclasses.replace(params.saw, cut_length=float(stopped_at)))
 
 
-def blade_position(params: PSTParams, t):
+def blade_position(params, t):
     """Blade distance from the cut end (m) at times ``t`` (s; float or array): ``speed (t - saw_start)`` within
     ``[0, saw.cut_length]`` (pass :func:`sawn` parameters for a saw that stopped on runaway)."""
     return np.clip(params.saw.speed * (np.asarray(t, dtype=float) - params.saw_start), 0.0, params.saw.cut_length)
 
 
-def stop_record(params: PSTParams, stopped_at: float, runaway: float) -> dict:
+def stop_record(params, stopped_at: float, runaway: float) -> dict:
     """``saw_stopped_at`` (m from the cut end, nan: it did not stop on runaway) with the reason under
     ``saw_stopped_at_null`` when nan, for a run file.
 

@@ -6,6 +6,7 @@ left alone.
 
 from __future__ import annotations
 
+from ... import markers
 from ..snow import DEM_STEADY_MAX, FIELD_SPEED, LONG_PST_SPEED, STEADY_FROM
 from .core import Context, slug
 from .fmt import bracket, finite, fx, ratio_range, spct
@@ -133,7 +134,4 @@ def block(ctx: Context) -> list[str]:
 
 def with_block(readme: str, bullets: list[str], begin: str = BEGIN, end: str = END) -> str | None:
     """``readme`` with the text between ``begin`` and ``end`` replaced by ``bullets``; None without the markers."""
-    i, j = readme.find(begin), readme.find(end)
-    if i < 0 or j < i:
-        return None
-    return readme[:i + len(begin)] + "\n" + "\n".join(bullets) + "\n" + readme[j:]
+    return markers.with_block(readme, bullets, begin, end)

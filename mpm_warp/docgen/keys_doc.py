@@ -10,13 +10,13 @@ the order of the tables and the functions that check each.
 
 from __future__ import annotations
 
-from ... import config
-from ...config import Block, Domain, Output, TimeControl
-from ...loader import TOP_LEVEL_KEYS
-from ...materials import MATERIAL_MODELS
-from ...scenes import SCENES
-from ...scenes.snow import MIN_WEAK_LAYER_CELLS, check_plane_strain
-from ...walls import Wall
+from .. import config
+from ..config import Block, Domain, Output, TimeControl
+from ..loader import TOP_LEVEL_KEYS
+from ..materials import MATERIAL_MODELS
+from ..scenes import SCENES
+from ..scenes.snow import MIN_WEAK_LAYER_CELLS, check_plane_strain
+from ..walls import Wall
 from .dataclass_doc import check_ranges, field_docs
 
 __all__ = ["keys_lines", "BEGIN", "END"]
@@ -104,7 +104,7 @@ def _scene_tables() -> list[str]:
 
 def keys_lines() -> list[str]:
     """The lines of the key reference (between :data:`BEGIN` and :data:`END` in ``docs/scenarios.md``)."""
-    lines = ["Generated from the parameter dataclasses by `python -m mpm_warp.studies.report.docs` (types and "
+    lines = ["Generated from the parameter dataclasses by `python -m mpm_warp.docgen` (types and "
              "defaults from the fields, units and text from their docstrings, ranges from the checks the loader "
              "runs; a range given as another key, such as `2 dx`, is relative to that key's value). A unit `-` "
              "is dimensionless.", ""]

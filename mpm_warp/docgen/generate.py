@@ -1,4 +1,4 @@
-"""``python -m mpm_warp.studies.report.docs``: write the generated parts of ``docs/scenarios.md`` and
+"""``python -m mpm_warp.docgen``: write the generated parts of ``docs/scenarios.md`` and
 ``README.md`` (the command-line reference and table from the argument parser, the scenario key reference
 from the parameter dataclasses); ``--check`` writes nothing and exits 1 if a committed file is out of date
 (``tests/test_docs_generated.py`` checks it in CI).
@@ -13,19 +13,19 @@ import argparse
 import os
 import sys
 
+from ..markers import with_block
 from . import cli_doc, keys_doc
-from .readme import with_block
 
 __all__ = ["generated_files", "main"]
 
 
 def _root() -> str:
-    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def _blocks() -> dict[str, list[tuple[str, str, list[str]]]]:
     """``{file: [(begin, end, lines), ...]}``: every generated block, by the file it lives in."""
-    from ...cli import build_parser
+    from ..cli import build_parser
 
     parser = build_parser()
     return {"docs/scenarios.md": [(cli_doc.BEGIN, cli_doc.END, cli_doc.cli_lines(parser)),
@@ -58,7 +58,7 @@ def generated_files(root: str | None = None) -> dict[str, tuple[str, str]]:
 
 def main(argv=None) -> int:
     """Write (or with ``--check`` only compare) the generated blocks; the exit status 1 means out of date."""
-    ap = argparse.ArgumentParser(prog="python -m mpm_warp.studies.report.docs", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m mpm_warp.docgen", description=__doc__.split("\n\n")[0])
     ap.add_argument("--root", default=None, help="the repository (default: the checkout this package runs from)")
     ap.add_argument("--check", action="store_true", help="write nothing; exit 1 if a generated block is out of date")
     a = ap.parse_args(argv)

@@ -1,7 +1,7 @@
 """The command-line reference in ``docs/scenarios.md`` and the README's command table, generated from the
 argument parser (:func:`mpm_warp.cli.build_parser`): every subcommand with every argument, its default and
 its help, so a flag added to the parser appears in the docs on the next ``python -m
-mpm_warp.studies.report.docs``.
+mpm_warp.docgen``.
 """
 
 from __future__ import annotations
@@ -78,7 +78,7 @@ def _default(a: argparse.Action) -> str:
 
 def cli_lines(parser: argparse.ArgumentParser) -> list[str]:
     """The lines of the command-line reference: per subcommand its synopsis and a table of its arguments."""
-    out = [f"Generated from `mpm_warp.cli.build_parser()` by `python -m mpm_warp.studies.report.docs`; "
+    out = [f"Generated from `mpm_warp.cli.build_parser()` by `python -m mpm_warp.docgen`; "
            f"`{parser.prog} COMMAND --help` prints the same.", ""]
     for name, help_, p in subcommands(parser):
         out += [f"### `{parser.prog} {name}`", "", help_[:1].upper() + help_[1:] + ".", "", "```",
