@@ -179,6 +179,10 @@ def scenario_from_dict(raw: dict, source: str = "scenario") -> Scenario:
                 raise ScenarioError(f"{source}: time.{k} is set by the {st.kind} scene; use [scene.settle] / "
                                     "scene.slope_angle")
     time = from_table(TimeControl, raw["time"], "time", source)
+    for key, value in table.items():     # as written by the user: a run file of an older release may hold []
+        if key.endswith("_layers") and isinstance(value, list) and not value:
+            raise InvalidArgument(f"scene.{key}", value, f"at least one layer ([[scene.{key}]] thickness = ..., "
+                                  "density = ...); leave the key out for the default")
     if st.expand is not None:
         base = os.path.dirname(os.path.abspath(source)) if os.path.isfile(source) else os.getcwd()
         table = st.expand(table, base)

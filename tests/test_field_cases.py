@@ -203,3 +203,15 @@ def test_a_slab_of_1000_layers_runs_and_its_run_file_names_every_group(tmp_path)
     g = run.static["group"]
     assert g.dtype == np.uint16 and len(run.attrs["groups"]) == 1002 and np.unique(g).size == 1002
     assert np.isfinite(run.frame(-1)["x"]).all()
+
+
+def test_a_run_file_of_an_older_release_with_empty_layer_lists_still_reads_back():
+    """Earlier releases stored ``slab_layers = []`` for a default slab: the refusal of an empty list is for what a
+    user writes, never for a stored scenario (users' files stay readable)."""
+    import mpm_warp as mw
+    from mpm_warp.loader import resolved_scenario
+
+    sc = mw.load_scenario("pst_demo")
+    stored = sc.to_dict()
+    stored["scene"] = {**stored["scene"], "slab_layers": [], "substratum_layers": []}
+    assert resolved_scenario(stored).scene == sc.scene

@@ -325,15 +325,10 @@ class PSTParams:
 
 
 def upgrade_table(table: dict) -> dict:
-    """A ``[scene]`` table checked for empty layer lists, and one of an older release in today's keys:
-    ``saw.from_end = "left" | "right"`` (the end
+    """A ``[scene]`` table of an older release in today's keys: ``saw.from_end = "left" | "right"`` (the end
     ``x = 0`` or ``x = L``) becomes ``saw.cut_from``, the upslope or downslope end of that slope. A negative
     slope angle must come with either: it once named the saw's end (the cut from the downslope end), now it
     only mirrors the column."""
-    for key in ("slab_layers", "substratum_layers"):
-        if key in table and isinstance(table[key], (list, tuple)) and not table[key]:
-            raise InvalidArgument(f"scene.{key}", table[key], "at least one layer ([[scene.{key}]] thickness = ..., "
-                                  "density = ...); leave the key out for the default")
     saw = table.get("saw")
     slope = table.get("slope_angle", 0.0)
     if isinstance(slope, (int, float)) and slope < 0.0 and not (isinstance(saw, dict) and saw.keys() & {
