@@ -59,7 +59,7 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
     t0 = time.perf_counter()
-    cases, refused = gather([args.data])
+    cases, refused = gather([args.data], calibrate=False)      # the selection's columns calibrate when built
     per, budget = (2, 30_000) if args.quick else (args.per_class, args.max_particles)
     chosen, counts = select(cases, per, args.seed, measured=not args.quick)
     runs = args.runs or tempfile.mkdtemp(prefix="mpm_warp_field_batch_")
@@ -74,6 +74,7 @@ def main(argv=None) -> int:
                           "per_class": per, "max_particles": budget},
             "workers": args.workers, "scores": batch.scores, "batch_wall_s": wall, "setup_wall_s": t1 - t0,
             "cases_per_hour": 3600.0 * len(ok) / wall if wall > 0 and batch.skipped == 0 else None,
+            "refused_at_build": [r.line() for r in batch.refused],
             "resumed_cases": batch.skipped, "runs": runs,
             "cases": [{k: r.get(k) for k in ("id", "test", "observed", "predicted", "static_class", "recorded_cut",
                                              "runaway_cut", "w_f", "w_f_source", "particles", "steps", "wall_s",

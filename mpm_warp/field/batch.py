@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from .. import io
 from ..errors import InvalidArgument
 from .cases import FieldCase, FieldRefusal, field_case, field_cases
+from .plain_words import in_field_terms
 from .protocol import FieldProtocol, decided, protocol_params
 from .scores import baseline_majority, field_class, scores
 from .static_rule import weac_static_class
@@ -50,9 +51,10 @@ class FieldBatch:
     out_dir: str
 
 
-def gather(inputs) -> tuple[list[FieldCase], list[FieldRefusal]]:
+def gather(inputs, calibrate: bool = True) -> tuple[list[FieldCase], list[FieldRefusal]]:
     """The cases and refusals of every input: a folder of CAAML files (``*.xml``, ``*.caaml``), one CAAML file,
-    or a CSV table of PSTs (:mod:`.table`)."""
+    or a CSV table of PSTs (:mod:`.table`). ``calibrate=False`` leaves the weak layer's calibration to the run
+    (a selection from many records then calibrates only what it runs)."""
     cases, refused = [], []
     for path in inputs:
         path = os.fspath(path)
@@ -63,7 +65,7 @@ def gather(inputs) -> tuple[list[FieldCase], list[FieldRefusal]]:
                 if row.refusal is not None:
                     refused.append(FieldRefusal(os.path.basename(path), row.id, "table row", row.refusal))
                     continue
-                r = field_case(row.profile, row.record, w_f=row.w_f)
+                r = field_case(row.profile, row.record, w_f=row.w_f, calibrate=calibrate)
                 (cases if isinstance(r, FieldCase) else refused).append(r)
             continue
         elif os.path.isfile(path):
@@ -71,7 +73,7 @@ def gather(inputs) -> tuple[list[FieldCase], list[FieldRefusal]]:
         else:
             raise InvalidArgument("INPUT", path, "a folder of CAAML files, a CAAML file or a CSV table of PSTs")
         for f in files:
-            for r in field_cases(f):
+            for r in field_cases(f, calibrate=calibrate):
                 (cases if isinstance(r, FieldCase) else refused).append(r)
     return cases, refused
 
@@ -132,11 +134,16 @@ def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
         if params is None:
             refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
             continue
+        try:
+            scenario = build(params, tc, name="field")          # calibrates the weak layer (once per column)
+        except InvalidArgument as e:
+            refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, params), c.outcome))
+            continue
         wf = c.fracture_energy
         tasks.append({"id": _case_id(c, k), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
                       "recorded_cut": c.record.cut_length, "static_class": weac_static_class(c.params),
                       "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
-                      "setup": note, "scenario": build(params, tc, name="field"), "out_dir": out_dir,
+                      "setup": note, "scenario": scenario, "out_dir": out_dir,
                       "device": device})
     return tasks
 
