@@ -103,7 +103,6 @@ def test_a_full_run_from_a_dirty_tree_is_refused_before_it_starts(monkeypatch, t
 KNOWN_DIRTY = {
     "convergence/results/error_vs_runtime_snow.json":
         "python benchmarks/convergence/error_vs_runtime_snow.py",            # both ladders, hours
-    "field/results/field_census.json": "python benchmarks/field/census.py DIR",   # DIR: the unpacked pits
     "perf/results/bonded_return_cost_cpu.json": "python benchmarks/perf/bonded_return_cost.py --device cpu",
     "perf/results/pst_scaling_cpu.json": "python benchmarks/perf/pst_scaling.py",
     "perf/results/return_cost_cpu.json": "python benchmarks/perf/return_cost.py",
