@@ -56,12 +56,14 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=0, help="seed of the sample (default 0)")
     p.add_argument("--workers", type=int, default=None, help="Dask workers (default one per core)")
     p.add_argument("--max-particles", type=int, default=FieldProtocol.max_particles, help="per-case budget")
+    p.add_argument("--no-measured", action="store_true",
+                   help="leave out the measured-density columns (a first, small sample: the stratified part only)")
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
     t0 = time.perf_counter()
     cases, refused = gather([args.data], calibrate=False)      # the selection's columns calibrate when built
     per, budget = (2, 30_000) if args.quick else (args.per_class, args.max_particles)
-    chosen, counts = select(cases, per, args.seed, measured=not args.quick)
+    chosen, counts = select(cases, per, args.seed, measured=not (args.quick or args.no_measured))
     runs = args.runs or tempfile.mkdtemp(prefix="mpm_warp_field_batch_")
     env = environment(args.device)
     t1 = time.perf_counter()
