@@ -158,9 +158,25 @@ def test_the_profile_command_prints_every_record(capsys):
 
 
 def test_snowpylot_reads_what_snowprofile_refuses():
-    """A SnowPilot export whose country code is outside ISO 3166 and whose other test is X reads whole."""
+    """A SnowPilot export with the country code "UT" (outside ISO 3166): snowprofile refuses the whole file, the
+    reader behind read_profile (snowpylot for SnowPilot exports) reads it and its PST becomes a column; and a pit
+    whose other test is X keeps its first test."""
+    import logging
+
+    import snowprofile.io as sp_io
+
+    logging.disable(logging.CRITICAL)
+    try:
+        with pytest.raises(Exception, match="country"):
+            sp_io.read_caaml6_xml(pit("snowpits-18413"))
+    finally:
+        logging.disable(logging.NOTSET)
+    prof = read_profile(pit("snowpits-18413"))
+    assert prof.country == "UT" and prof.slope_angle == 40.0
+    (case,) = field_cases(pit("snowpits-18413"), calibrate=False)
+    assert isinstance(case, FieldCase) and case.test == "PST 44/100 (End) down 93 cm"
+    assert case.params.column_ends == "slope_normal"          # not the US or Canada: the European standard
     prof = read_profile(pit("snowpits-45545"))
-    assert prof.caaml_version == "6" and len(prof.pst_tests) == 2
     assert [t.propagation for t in prof.pst_tests] == ["End", "X"]
 
 

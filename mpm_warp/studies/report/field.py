@@ -46,3 +46,54 @@ def render_census(data: dict, ctx) -> list[str]:
             "density is a flagged fallback (no hardness, no grain, or a grain without a law; docs/profiles.md).",
             f"- Setting up every record, calibration included, took {secs(c['wall_s'])}.", "", env_note(data)]
     return out
+
+
+def _ba(s: dict) -> str:
+    v = s.get("balanced_accuracy")
+    return "-" if v is None else f"{v:.2f}"
+
+
+def _recall(s: dict, c: str) -> str:
+    v = (s.get("recall") or {}).get(c)
+    return "-" if v is None else f"{v:.2f}"
+
+
+#: the median field case's wall time the issue asks for (s, 2 CPU cores)
+CASE_BUDGET_S = 60.0
+
+
+def _batch_command(d: dict) -> str:
+    sel = d["selection"]
+    return (f"python benchmarks/field/field_batch.py DIR --runs RUNDIR --per-class {sel['per_class']} --seed "
+            f"{sel['seed']}" + (" --no-measured" if not sel.get("measured") else "")
+            + (f" --workers {d['workers']}" if d.get("workers") else ""))
+
+
+@section("field", "Field outcomes against the observers", "field/results/field_batch.json", _batch_command,
+         question="Does the model predict a real PST's outcome (END, SF, ARR) better than the majority class and "
+                  "weac's static rule?")
+def render_batch(data: dict, ctx) -> list[str]:
+    sc, sel = data["scores"], data["selection"]
+    rows = [[name, count(s["n"]), _ba(s), _recall(s, "END"), _recall(s, "SF"), _recall(s, "ARR")]
+            for name, s in (("the model (MPM, field protocol)", sc["model"]), ("majority class", sc["majority"]),
+                            ("weac's static rule", sc["weac_static"]))]
+    out = [f"Cases: {count(sc['cases'])} scored ({count(sc['failed'])} failed), drawn from "
+           f"{count(sel['runnable'])} runnable records: {sel.get('measured', 0)} with measured slab densities, and "
+           f"{sel.get('END', 0)} END, {sel.get('SF', 0)} SF, {sel.get('ARR', 0)} ARR by class (seed "
+           f"{sel['seed']}).", ""]
+    out += table(["predictor", "cases", "balanced accuracy", "recall END", "recall SF", "recall ARR"], rows)
+    conf = sc["model"]["confusion"]
+    out += ["", "The model's confusion matrix (rows: observed; columns: predicted):", ""]
+    out += table(["observed", *conf["columns"]], [[r, *[count(n) for n in c]] for r, c in zip(conf["rows"],
+                                                                                          conf["counts"], strict=True)])
+    m, best = sc["model"]["balanced_accuracy"], max(sc["majority"]["balanced_accuracy"] or 0.0,
+                                                    sc["weac_static"]["balanced_accuracy"] or 0.0)
+    med = sc["wall_s"]["median"]
+    out += ["", f"**Check:** the model's balanced accuracy above both baselines': {_ba(sc['model'])} against "
+            f"{best:.2f}, **{'pass' if m is not None and m > best else 'fail'}**"
+            + (" (too few cases to tell: at least 50 per class are needed)" if sc["cases"] < 150 else "") + ".",
+            f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time: {secs(med)}, "
+            f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** (particle budget "
+            f"{count(sel['max_particles'])}; {fx(data.get('cases_per_hour'), 0)} cases per hour with "
+            f"{data.get('workers') or 'one per core'} workers).", "", env_note(data)]
+    return out
