@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from .core import section
-from .fmt import count, env_note, fx, pct, secs, table
+from .fmt import count, env_note, fx, pct, secs, spct, table
 
 #: the share of End/SF/Arr records that must become runnable columns (issue: real pits in)
 TARGET = 0.80
@@ -77,10 +77,12 @@ def render_batch(data: dict, ctx) -> list[str]:
     rows = [[name, count(s["n"]), _ba(s), _recall(s, "END"), _recall(s, "SF"), _recall(s, "ARR")]
             for name, s in (("the model (MPM, field protocol)", sc["model"]), ("majority class", sc["majority"]),
                             ("weac's static rule", sc["weac_static"]))]
-    out = [f"Cases: {count(sc['cases'])} scored ({count(sc['failed'])} failed), drawn from "
-           f"{count(sel['runnable'])} runnable records: {sel.get('measured', 0)} with measured slab densities, and "
-           f"{sel.get('END', 0)} END, {sel.get('SF', 0)} SF, {sel.get('ARR', 0)} ARR by class (seed "
-           f"{sel['seed']}).", ""]
+    built = data.get("refused_at_build") or []
+    out = [f"Cases: {count(sc['cases'])} scored ({count(sc['failed'])} failed), drawn from the "
+           f"{count(sel['runnable'])} records set up before calibration: {sel.get('measured', 0)} with measured slab "
+           f"densities, and {sel.get('END', 0)} END, {sel.get('SF', 0)} SF, {sel.get('ARR', 0)} ARR by class (seed "
+           f"{sel['seed']}); {count(len(built))} of those refused when built (the per-case budget, or the "
+           "calibration), in the JSON's `refused_at_build`.", ""]
     out += table(["predictor", "cases", "balanced accuracy", "recall END", "recall SF", "recall ARR"], rows)
     conf = sc["model"]["confusion"]
     out += ["", "The model's confusion matrix (rows: observed; columns: predicted):", ""]
@@ -91,9 +93,21 @@ def render_batch(data: dict, ctx) -> list[str]:
     med = sc["wall_s"]["median"]
     out += ["", f"**Check:** the model's balanced accuracy above both baselines': {_ba(sc['model'])} against "
             f"{best:.2f}, **{'pass' if m is not None and m > best else 'fail'}**"
-            + (" (too few cases to tell: at least 50 per class are needed)" if sc["cases"] < 150 else "") + ".",
+            + (" (too few cases to tell: at least 50 per class are needed)" if sc["cases"] < 150 else "") + ".", "",
             f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time: {secs(med)}, "
             f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** (particle budget "
-            f"{count(sel['max_particles'])}; {fx(data.get('cases_per_hour'), 0)} cases per hour with "
-            f"{data.get('workers') or 'one per core'} workers).", "", env_note(data)]
+            f"{count(sel['max_particles'])}, one thread per case, {data.get('workers') or 'one per core'} workers; "
+            + (f"{fx(data['cases_per_hour'], 0)} cases per hour)." if data.get("cases_per_hour") else
+               f"the {count(data['resumed_cases'])} cases were run by an earlier invocation of the same command, "
+               "which this one found finished and scored: their wall times are that run's, on this shared machine "
+               "while another benchmark ran beside the two workers, so they are upper bounds).")]
+    read = [c for c in data.get("cases", []) if c.get("w_f_source") == "read back" and c.get("runaway_cut")
+            and c.get("recorded_cut")]
+    if read:
+        d = [c["runaway_cut"] / c["recorded_cut"] - 1.0 for c in read]
+        out += ["", f"- **Where the crack ran away:** in the {len(read)} cases whose fracture energy was read back "
+                f"from the recorded cut (weac's G there), the run's runaway cut is {spct(min(d))} to {spct(max(d))} "
+                "off the recorded one, where weac's energy criterion puts it exactly (it gave the fracture energy). "
+                "What follows the runaway is the model's own."]
+    out += ["", env_note(data)]
     return out
