@@ -20,11 +20,12 @@ __all__ = ["gather_rows_func"]
 
 
 @functools.cache
-def gather_rows_func(T):
+def gather_rows_func(T, portable=False):
     """Build ``gather_rows(grid_v, n0, s0, W, fx) -> mat32``: rows ``v``, ``B_0 / dx``, ``B_1 / dx`` (m/s).
 
     ``grid_v`` is the flat grid of nodal velocities (``vec2``), ``n0`` the flat index of the base node and
-    ``s0`` the stride of a row along x.
+    ``s0`` the stride of a row along x. ``portable`` builds CUDA's plain code on the CPU too
+    (``tests/test_native_rows.py`` compares the two there).
     """
     V = vec(2, T)
     Wt = weights(2, T)
@@ -35,7 +36,7 @@ def gather_rows_func(T):
     {s} f0 = fx.c[0], f1 = fx.c[1];
     {s} dy0 = wy0 * (({s})0 - f1), dy1 = wy1 * (({s})1 - f1), dy2 = wy2 * (({s})2 - f1);
     wp::mat_t<3, 2, {s}> out;
-#if defined(__CUDA_ARCH__)
+#if defined(__CUDA_ARCH__) || {int(portable)}
     {s} acc[4] = {{0, 0, 0, 0}}, bx[2] = {{0, 0}};
     for (int a = 0; a < 3; ++a) {{
         const {s}* p = (const {s}*)(grid_v.data + (n0 + a * s0));

@@ -20,13 +20,14 @@ __all__ = ["scatter_rows_func"]
 
 
 @functools.cache
-def scatter_rows_func(T):
+def scatter_rows_func(T, portable=False):
     """Build ``scatter_rows(grid_m, grid_p, n0, s0, W, fx, dx, mass, mv, A)`` for scalar type ``T``.
 
     ``grid_m`` (kg/m) and ``grid_p`` (kg/s: momentum per unit depth, ``vec2``) are one flat grid copy,
     ``n0`` the flat index of the base node and ``s0`` the stride of a row along x; ``W`` (3 x 2) and ``fx``
     the stencil weights and offset (``kernels/shape.py``), ``dx`` (m), ``mass`` (kg/m), ``mv`` (kg/s) and
-    ``A`` (kg/s: ``m C - dt V0 4/dx^2 tau``).
+    ``A`` (kg/s: ``m C - dt V0 4/dx^2 tau``). ``portable`` builds CUDA's node-by-node code on the CPU too
+    (``tests/test_native_rows.py`` compares the two there).
     """
     V = vec(2, T)
     M = mat(2, T)
@@ -40,7 +41,7 @@ def scatter_rows_func(T):
     {s} cy[6] = {{A.data[0][1] * ey0, A.data[1][1] * ey0, A.data[0][1] * ey1, A.data[1][1] * ey1,
                  A.data[0][1] * ey2, A.data[1][1] * ey2}};
     {s} m0 = mv.c[0], m1 = mv.c[1];
-#if defined(__CUDA_ARCH__)
+#if defined(__CUDA_ARCH__) || {int(portable)}
     for (int a = 0; a < 3; ++a) {{
         int na = n0 + a * s0;
         {s} wa = W.data[a][0];
