@@ -39,6 +39,7 @@ from .constitutive import (
     material_struct,
     trial_func,
 )
+from .p2g_rows import scatter_rows_func
 from .shape import NONNEG, in_grid_func, stencil_func
 from .types import mat, vec
 
@@ -65,6 +66,7 @@ def p2g_kernel(dim, T, model, track_yield):
     P = material_struct(T)
     stencil = stencil_func(T, dim)
     in_grid = in_grid_func(dim)
+    scatter_rows = scatter_rows_func(T) if dim == 2 else None
     trial = trial_func(T, dim)
     update = constitutive_update_func(dim, T, model)
     plastic = model in PLASTIC_MODELS
@@ -141,28 +143,9 @@ def p2g_kernel(dim, T, model, track_yield):
             s0 = strides[0] & NONNEG
             n0 = (b[0] * s0 + b[1] * strides[1]) & NONNEG
             # A dpos = A[:, 0] dpos_x + A[:, 1] dpos_y (Warp's order), its column terms formed once per stencil
-            # row and column: the same sums in the same order as the per-node product, bit for bit
-            a0 = V(A[0, 0], A[1, 0])
-            a1 = V(A[0, 1], A[1, 1])
-            cy0 = a1 * ((T(0.0) - fx[1]) * dx)
-            cy1 = a1 * ((T(1.0) - fx[1]) * dx)
-            cy2 = a1 * ((T(2.0) - fx[1]) * dx)
-            wy0 = W[0, 1]
-            wy1 = W[1, 1]
-            wy2 = W[2, 1]
-            for a in range(3):
-                na = n0 + a * s0
-                wa = W[a, 0]
-                cx = a0 * ((T(float(a)) - fx[0]) * dx)
-                w = wa * wy0
-                grid_m[na] += w * mass
-                grid_p[na] += w * (mv + (cx + cy0))
-                w = wa * wy1
-                grid_m[na + 1] += w * mass
-                grid_p[na + 1] += w * (mv + (cx + cy1))
-                w = wa * wy2
-                grid_m[na + 2] += w * mass
-                grid_p[na + 2] += w * (mv + (cx + cy2))
+            # row and column: the same sums in the same order as the per-node product, bit for bit; the
+            # scatter as vector operations on the CPU (kernels/p2g_rows.py)
+            scatter_rows(grid_m, grid_p, n0, s0, W, fx, dx, mass, mv, A)
         else:
             n0 = b[0] * strides[0] + b[1] * strides[1] + b[2]
             for a in range(3):

@@ -9,6 +9,7 @@ steps is captured once as a graph and replayed.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 import time
@@ -19,6 +20,7 @@ import warp as wp
 
 from .interfaces import closure_factors
 from .kernels.crack_band import column_sums_zero_kernel, kappa_column_mean_kernel, kappa_column_sum_kernel
+from .kernels.fpmode import flush_kernels
 from .kernels.g2p import g2p_kernel
 from .kernels.grid_update import grid_update_kernel, wall_state_kernel
 from .kernels.interface_closure import closure_kernel
@@ -27,7 +29,7 @@ from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec
 from .meeting import MeetingPoint
 from .model import Model, State, material_params
-from .step_profile import stage_walls
+from .step_profile import stage_walls, timed
 
 __all__ = ["Stepper", "default_threads", "grid_copies"]
 
@@ -53,16 +55,6 @@ def grid_copies(device: str, n_particles: int, grid_shape, n_threads: int | None
 
 def _no_wait() -> None:  # the meeting of a one-thread step: nothing to wait for
     pass
-
-
-def _timed(record: list | None, k: int, stage: str, run) -> None:
-    """``run()``, appending ``(k, stage, start, end)`` perf-counter times to ``record`` unless it is None."""
-    if record is None:
-        run()
-        return
-    t0 = time.perf_counter()
-    run()
-    record.append((k, stage, t0, time.perf_counter()))
 
 
 def _chunks(start: int, end: int, n: int) -> list[tuple[int, int]]:
@@ -119,6 +111,13 @@ class Stepper:
         # per thread: [particles clamped at the grid edge, particles skipped with a stencil outside the grid,
         #              singular-value floor events, inversions det F_tr <= 0]
         self.counts = wp.zeros((nt, 4), dtype=wp.int32, device=dev)
+        # CPU: each thread steps with subnormal numbers flushed to zero, its own mode kept and put back after
+        # (kernels/fpmode.py: round-off-sized strains otherwise cost the elastic P2G microcode assists)
+        self._fp = []
+        if not wp.get_device(dev).is_cuda:
+            saved = wp.zeros(nt, dtype=wp.int32, device=dev)
+            self._fp = [tuple(wp.launch(kern, 1, inputs=[saved, k], device=dev, record_cmd=True)
+                              for kern in flush_kernels()) for k in range(nt)]
         has_walls = bool(model.walls)
         nw = max(len(model.walls), 1)
         self.wall_impulses = wp.zeros((nt, nw), dtype=vec(dim, wp.float64), device=dev) if has_walls else None
@@ -233,7 +232,19 @@ class Stepper:
         """Every recorded launch of the plan (for compiling ahead of timing)."""
         walls = [self._wall_state] if self._wall_state is not None else []
         return [self._begin, *walls, *[k for ks in self._p2g for k in ks], *self._grid, *self._g2p,
-                *self._columns, self._end, *self.actions, *self._closure]
+                *self._columns, self._end, *[f for fs in self._fp for f in fs], *self.actions, *self._closure]
+
+    @contextlib.contextmanager
+    def flushed(self, k: int = 0):
+        """Run the body with the calling thread (thread ``k`` of the step) flushing subnormals to zero, as the
+        step's own threads do (kernels/fpmode.py; nothing on CUDA). For timing stages one by one."""
+        if self._fp:
+            self._fp[k][0].launch()
+        try:
+            yield
+        finally:
+            if self._fp:
+                self._fp[k][1].launch()
 
     # ------------------------------------------------------------------ steps
     def _scatter(self, k: int) -> None:
@@ -267,15 +278,16 @@ class Stepper:
         """
         stages = (("p2g", lambda: self._scatter(k)), ("grid", self._grid[k].launch), ("g2p", self._g2p[k].launch))
         wait = self._barrier.wait if self._barrier is not None else _no_wait
-        for _ in range(n):
-            if k == 0:
-                _timed(record, k, "serial", self._before_scatter)
-            wait()
-            for name, run in stages:
-                _timed(record, k, name, run)
+        with self.flushed(k):
+            for _ in range(n):
+                if k == 0:
+                    timed(record, k, "serial", self._before_scatter)
                 wait()
-            if k == 0:
-                _timed(record, k, "serial", self._after_gather)
+                for name, run in stages:
+                    timed(record, k, name, run)
+                    wait()
+                if k == 0:
+                    timed(record, k, "serial", self._after_gather)
 
     def _team_steps(self, n: int, record: list | None = None) -> None:
         """``n`` steps on all threads: 1..n_threads-1 from the pool, thread 0 the caller (no hang on an error)."""

@@ -7,10 +7,22 @@ on several threads").
 
 from __future__ import annotations
 
-__all__ = ["stage_walls", "STAGES"]
+import time
+
+__all__ = ["stage_walls", "timed", "STAGES"]
 
 #: the parallel stages of a step, in order
 STAGES = ("p2g", "grid", "g2p")
+
+
+def timed(record: list | None, k: int, stage: str, run) -> None:
+    """``run()``, appending ``(k, stage, start, end)`` perf-counter times to ``record`` unless it is None."""
+    if record is None:
+        run()
+        return
+    t0 = time.perf_counter()
+    run()
+    record.append((k, stage, t0, time.perf_counter()))
 
 
 def stage_walls(record: list, n: int, n_threads: int, total: float) -> dict:

@@ -41,10 +41,11 @@ RECORD_PATH = (os.path.join(os.path.dirname(HERE), "benchmarks", "perf", "result
 CI_OPT_LEVEL = 2
 THREADS = max(1, min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1))
 
-#: kernel families (factory names) each kind of case launches: the step, its health check and energies; walls;
-#: the stresses where the output holds p, q; the bonded layer's column means and tracker; the monitors' kernels
+#: kernel families (factory names) each kind of case launches: the step (on the CPU with its threads' floating-point
+#: mode set and put back, flush_kernels), its health check and energies; walls; the stresses where the output holds
+#: p, q; the bonded layer's column means and tracker; the monitors' kernels
 STEP = {"begin_step_kernel", "p2g_kernel", "grid_update_kernel", "g2p_kernel", "end_step_kernel", "health_kernel",
-        "energy_kernel", "wall_state_kernel"}
+        "energy_kernel", "wall_state_kernel", "flush_kernels"}
 BONDED = {"kappa_column_sum_kernel", "kappa_column_mean_kernel", "column_sums_zero_kernel", "weak_layer_kernel"}
 EXPECTED = {"elastic_block": STEP | {"stress_kernel"}, "pst": STEP | BONDED | {"deflection_kernel"},
             "shear_test": STEP | BONDED | {"push_kernel", "stress_kernel"}, "material_point": {"drive_kernel"}}
@@ -87,12 +88,13 @@ def test_every_case_ran_and_launched_its_kernels(compiled):
         assert families == _expected(case), case
         assert r["steps"] > 0 and r["particles"] > 0, case
     # one module per kernel variant: the three PST scenes share theirs, precisions share only the kernels
-    # without a scalar type (the clock's and the column sums' reset)
+    # without a scalar type (the clock's, the column sums' reset, the floating-point mode's two)
     step = {c: {n for n in runs[c]["modules"] if modules[n]["family"] != "drive_kernel"}
             for c in ("pst_demo/2d/float32", "pst_slope/2d/float32", "pst_demo/2d/float64")}
     assert step["pst_demo/2d/float32"] == step["pst_slope/2d/float32"]
     shared = step["pst_demo/2d/float32"] & step["pst_demo/2d/float64"]
-    assert {modules[n]["family"] for n in shared} == {"end_step_kernel", "column_sums_zero_kernel"} and len(shared) == 2
+    assert {modules[n]["family"] for n in shared} == {"end_step_kernel", "column_sums_zero_kernel", "flush_kernels"}
+    assert len(shared) == 4
     by_family = {}
     for m in modules.values():
         by_family[m["family"]] = by_family.get(m["family"], 0) + 1
