@@ -24,9 +24,6 @@ CP_OVER_CS = math.sqrt(2 * 0.7 / 0.4)
 #: c_p (m/s) where a file names no slab wave speed: the slab of pst_flat/pst_slope and the ladder PST
 #: (E 5 MPa, nu 0.3, 250 kg/m^3), the stiffest slab of the studies that do not store one
 DEFAULT_CP = 164.08
-#: files allowed to break a check, each with its reason (none today: keep it explicit)
-KNOWN_EXCEPTIONS: dict[str, str] = {}
-
 
 def _numbers(path: str):
     """The file's JSON and the non-finite tokens (NaN, Infinity) it holds."""
@@ -73,8 +70,6 @@ def test_there_are_results_to_check():
 @pytest.mark.parametrize("path", FILES, ids=lambda p: os.path.relpath(p, ROOT))
 def test_committed_result_is_finite_and_slower_than_sound(path):
     rel = os.path.relpath(path, ROOT)
-    if rel in KNOWN_EXCEPTIONS:
-        pytest.skip(KNOWN_EXCEPTIONS[rel])
     data, bad = _numbers(path)
     assert not bad, f"{rel} holds {len(bad)} non-finite numbers ({sorted(set(bad))}): write it through " \
                     "mpm_warp.finite_json (null with its reason)"
