@@ -233,9 +233,7 @@ def _run_case(task: dict) -> dict:
         data = io.read_run(out + ".part.h5")
         rec.update(status="ok", result={k: getattr(res, k) for k in RESULT_FIELDS}, scene_result=dict(res.scene_result),
                    final={k: float(v[-1]) for k, v in data.scalars.items() if len(v)}, n_frames=data.n_frames)
-        if os.path.exists(io.checkpoint_path_for(out + ".part.h5")):
-            os.replace(io.checkpoint_path_for(out + ".part.h5"), io.checkpoint_path_for(out + ".h5"))
-        os.replace(out + ".part.h5", out + ".h5")
+        io.promote_part(out)
     except Exception as e:
         rec.update(status="failed", error=f"{type(e).__name__}: {e}", traceback=traceback.format_exc(limit=-4))
     rec["elapsed_s"] = time.perf_counter() - t0

@@ -110,9 +110,7 @@ def run_case(task: dict) -> dict:
                    slab_fracture_at=_finite(o.get("slab_fracture_at")), note=o.get("note", ""),
                    sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
                    n_frames=io.read_run(out + ".part.h5").n_frames)
-        if os.path.exists(io.checkpoint_path_for(out + ".part.h5")):
-            os.replace(io.checkpoint_path_for(out + ".part.h5"), io.checkpoint_path_for(out + ".h5"))
-        os.replace(out + ".part.h5", out + ".h5")
+        io.promote_part(out)
         rec["run_file"] = os.path.basename(out + ".h5")
     except Exception as e:      # a failing case is recorded with its error; it never stops the batch
         rec.update(status="failed", error=f"{type(e).__name__}: {e}", traceback=traceback.format_exc(limit=-4))

@@ -24,7 +24,7 @@ from .checkpoint import (
 from .hdf5 import CHECKPOINT_FORMAT, FORMAT, FORMAT_VERSION
 from .lock import is_live, output_lock
 from .paths import check_output_dir, check_output_file
-from .records import finished_record, write_record
+from .records import finished_record, promote_part, write_record
 from .rundata import RunData, read_run
 from .runfile import RunWriter
 from .space import OutOfSpace, atomic_write, ensure_space, space_errno
@@ -32,4 +32,5 @@ from .space import OutOfSpace, atomic_write, ensure_space, space_errno
 __all__ = ["FORMAT", "FORMAT_VERSION", "CHECKPOINT_FORMAT", "RunWriter", "RunData", "read_run",
            "write_checkpoint", "read_checkpoint", "read_checkpoint_meta", "checkpoint_path_for",
            "checkpoint_is_intact", "output_lock", "is_live", "check_output_file", "check_output_dir", "OutOfSpace",
-           "atomic_write", "ensure_space", "space_errno", "OutputError", "write_record", "finished_record"]
+           "atomic_write", "ensure_space", "space_errno", "OutputError", "write_record", "finished_record",
+           "promote_part"]

@@ -9,12 +9,14 @@ finished case and reruns none.
 from __future__ import annotations
 
 import json
+import os
 
 from ..errors import MPMError
+from .checkpoint import checkpoint_path_for
 from .rundata import read_run
 from .space import atomic_write
 
-__all__ = ["write_record", "finished_record"]
+__all__ = ["write_record", "finished_record", "promote_part"]
 
 
 def write_record(path: str, obj: dict, what: str, default=None) -> None:
@@ -38,3 +40,11 @@ def finished_record(out: str) -> dict | None:
     except (OSError, ValueError, MPMError):
         pass
     return None
+
+
+def promote_part(out: str) -> None:
+    """Move a complete ``out.part.h5`` (and its checkpoint, when there is one) to ``out.h5``: the case is done."""
+    part = out + ".part.h5"
+    if os.path.exists(checkpoint_path_for(part)):
+        os.replace(checkpoint_path_for(part), checkpoint_path_for(out + ".h5"))
+    os.replace(part, out + ".h5")
