@@ -22,7 +22,7 @@ def cmd_field(a) -> int:
     from .field.protocol import FieldProtocol
 
     res = run_field(a.inputs, a.out, workers=a.workers, scheduler=a.scheduler, device=a.device, limit=a.limit,
-                    protocol=FieldProtocol(max_particles=a.max_particles), progress=not a.quiet)
+                    protocol=FieldProtocol(max_particles=a.max_particles, threads=a.threads), progress=not a.quiet)
     sc = res.scores
 
     def ba(k):
@@ -46,11 +46,13 @@ def add_field(sub) -> None:
                        description=DESCRIPTION, epilog=EXAMPLE)
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="folder of CAAML files, a CAAML file, or a CSV table")
     p.add_argument("--out", required=True, help="folder of the runs and results (an earlier batch's cases are kept)")
-    p.add_argument("--workers", type=int, help="workers of the local cluster (default: one per core)")
+    p.add_argument("--workers", type=int, help="workers of the local cluster (default: the cores over --threads)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--device", default="cpu", help="cpu | cuda | cuda:N (default cpu)")
     p.add_argument("--limit", type=int, help="run only the first N runnable cases")
     p.add_argument("--max-particles", type=int, default=FieldProtocol.max_particles,
                    help=f"per-case budget: most particles of a column (default {FieldProtocol.max_particles:,})")
+    p.add_argument("--threads", type=int, default=FieldProtocol.threads,
+                   help="CPU threads of each case's step (default 1); workers x threads should not exceed the cores")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_field)

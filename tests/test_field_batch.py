@@ -9,6 +9,7 @@ import pytest
 
 from mpm_warp.cli import main
 from mpm_warp.field.batch import run_field, score_records
+from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.field.scores import baseline_majority, scores
 from mpm_warp.field.table import table_profiles
 
@@ -49,7 +50,8 @@ def test_a_table_row_becomes_a_profile_or_one_line(tmp_path):
 
 
 def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
-    """The first run stops after one case (as a kill would); the second keeps that case's files untouched."""
+    """The first run stops after one case (as a kill would); the second keeps that case's files untouched and runs
+    the other on the 2 threads its protocol asks for."""
     table = tmp_path / "psts.csv"
     table.write_text(TABLE)
     out = str(tmp_path / "out")
@@ -58,7 +60,8 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     assert rec["status"] == "ok" and first.skipped == 0
     done = os.path.join(out, rec["id"] + ".json")
     stamp = os.stat(done).st_mtime_ns
-    again = run_field([str(table)], out, workers=1, progress=False)
+    again = run_field([str(table)], out, workers=1, progress=False, protocol=FieldProtocol(threads=2))
+    assert [r["threads"] for r in again.records] == [1, 2]     # what each case's step ran on
     assert again.skipped == 1 and len(again.records) == 2 and os.stat(done).st_mtime_ns == stamp
     assert all(r["status"] == "ok" for r in again.records)
     assert [r["observed"] for r in again.records] == ["END", "ARR"]
@@ -80,3 +83,5 @@ def test_bad_batch_arguments_are_one_line(tmp_path, capsys):
     table.write_text(TABLE)
     assert main(["field", str(table), "--out", str(tmp_path / "o"), "--workers", "0"]) == 2
     assert "workers = 0 is invalid: expected an integer >= 1" in capsys.readouterr().err
+    assert main(["field", str(table), "--out", str(tmp_path / "o"), "--threads", "0"]) == 2
+    assert "threads = 0 is invalid" in capsys.readouterr().err

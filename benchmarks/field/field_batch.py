@@ -7,8 +7,9 @@ of each of END, SF and ARR, drawn with ``--seed``, from the rest), and runs them
 field_batch.json``: the selection, the scores of the model and of both baselines (confusion matrix, recall
 per class, balanced accuracy), the cost per case (median wall time, particles, steps) and the batch's rate.
 
-Usage: ``python benchmarks/field/field_batch.py DIR --runs RUNDIR [--per-class 50] [--workers 2]``; ``--quick``:
-two cases per class on a small budget, to a temporary folder. Hours of CPU for the full selection on 2 cores.
+Usage: ``python benchmarks/field/field_batch.py DIR --runs RUNDIR [--per-class 50] [--workers 2] [--threads 1]``;
+``--quick``: two cases per class on a small budget, to a temporary folder. Hours of CPU for the full
+selection on 2 cores.
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ def main(argv=None) -> int:
     p.add_argument("--per-class", type=int, default=50, help="sampled cases per observed class (default 50)")
     p.add_argument("--seed", type=int, default=0, help="seed of the sample (default 0)")
     p.add_argument("--workers", type=int, default=None, help="Dask workers (default one per core)")
+    p.add_argument("--threads", type=int, default=FieldProtocol.threads, help="CPU threads of each case (default 1)")
     p.add_argument("--max-particles", type=int, default=FieldProtocol.max_particles, help="per-case budget")
     p.add_argument("--no-measured", action="store_true",
                    help="leave out the measured-density columns (a first, small sample: the stratified part only)")
@@ -68,13 +70,14 @@ def main(argv=None) -> int:
     env = environment(args.device)
     t1 = time.perf_counter()
     batch = run_cases(chosen, [], runs, workers=args.workers, device=args.device,
-                      protocol=FieldProtocol(max_particles=budget), progress=True)
+                      protocol=FieldProtocol(max_particles=budget, threads=args.threads), progress=True)
     wall = time.perf_counter() - t1
     ok = [r for r in batch.records if r.get("status") == "ok"]
     data = {"name": "field_batch", "data": os.path.basename(os.path.normpath(args.data)), "environment": env,
             "selection": {"runnable": len(cases), "refused": len(refused), **counts, "seed": args.seed,
                           "per_class": per, "max_particles": budget},
-            "workers": args.workers, "scores": batch.scores, "batch_wall_s": wall, "setup_wall_s": t1 - t0,
+            "workers": args.workers, "threads_per_case": args.threads,
+            "scores": batch.scores, "batch_wall_s": wall, "setup_wall_s": t1 - t0,
             "cases_per_hour": 3600.0 * len(ok) / wall if wall > 0 and batch.skipped == 0 else None,
             "refused_at_build": [r.line() for r in batch.refused],
             "resumed_cases": batch.skipped, "runs": runs,

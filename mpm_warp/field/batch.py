@@ -101,14 +101,21 @@ def run_case(task: dict) -> dict:
     rec = {k: task[k] for k in ("id", "pit", "test", "observed", "recorded_cut", "static_class", "w_f",
                                  "w_f_source", "setup")}
     rec["status"] = "failed"
+    used = {}
+
+    def until_decided(sim, frame):
+        used["threads"] = sim.stepper.n_threads        # the threads the step really ran on
+        return not decided(sim)
+
     try:
         res = run(task["scenario"], out + ".part.h5", device=task["device"], overwrite=True,
-                  callback=lambda sim, frame: not decided(sim))
+                  n_threads=task.get("threads"), callback=until_decided)
         o = res.scene_result.get("outcome", {})
         rec.update(status="ok", predicted=o.get("class") or "running", field_line=o.get("field_line"),
                    runaway_cut=_finite(res.scene_result.get("runaway_cut")),
                    slab_fracture_at=_finite(o.get("slab_fracture_at")), note=o.get("note", ""),
                    sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
+                   threads=used.get("threads"),
                    n_frames=io.read_run(out + ".part.h5").n_frames)
         io.promote_part(out)
         rec["run_file"] = os.path.basename(out + ".h5")
@@ -142,11 +149,11 @@ def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
                       "recorded_cut": c.record.cut_length, "static_class": weac_static_class(c.params),
                       "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
                       "setup": note, "scenario": scenario, "out_dir": out_dir,
-                      "device": device})
+                      "device": device, "threads": proto.threads})
     return tasks
 
 
-def _execute(todo, records, workers, scheduler, stream, total) -> None:
+def _execute(todo, records, workers, scheduler, stream, total, threads=1) -> None:
     from distributed import Client, LocalCluster, as_completed
 
     with contextlib.ExitStack() as stack:
@@ -154,8 +161,8 @@ def _execute(todo, records, workers, scheduler, stream, total) -> None:
             client = stack.enter_context(Client(scheduler))
         else:
             cluster = stack.enter_context(LocalCluster(
-                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                dashboard_address=None, silence_logs=40, env={"MPM_WARP_THREADS": "1"}))
+                n_workers=workers or max(1, (os.cpu_count() or 1) // threads), threads_per_worker=1, processes=True,
+                dashboard_address=None, silence_logs=40, env={"MPM_WARP_THREADS": str(threads)}))
             client = stack.enter_context(Client(cluster))
         token, t0, done = uuid.uuid4().hex[:8], time.perf_counter(), 0
         futures = {client.submit(run_case, t, key=f"{t['id']}-{token}", retries=1, pure=False, priority=-i): t
@@ -191,7 +198,8 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
     out_dir : str
         Folder of the runs and the results (created; an earlier batch's finished cases are kept and not rerun).
     workers : int, optional
-        Worker processes of the local cluster (default: one per core); ignored with ``scheduler``.
+        Worker processes of the local cluster (default: the cores over the protocol's ``threads``); ignored with
+        ``scheduler``.
     scheduler : str, optional
         Address of a running Dask scheduler (mpm_warp installed on its workers; ``out_dir`` visible to them).
     device : str, optional
@@ -224,7 +232,7 @@ def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None =
     todo = [t for t in tasks if records[t["id"]] is None]
     stream = sys.stderr if progress is True else (progress or None)
     if todo:
-        _execute(todo, records, workers, scheduler, stream, len(tasks))
+        _execute(todo, records, workers, scheduler, stream, len(tasks), proto.threads)
     recs = [records[t["id"]] for t in tasks]
     _write_outputs(out_dir, recs, refused)
     sc = score_records(recs)
@@ -237,7 +245,8 @@ def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None =
 
 #: the columns of cases.csv
 CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "static_class", "recorded_cut", "runaway_cut",
-                "slab_fracture_at", "w_f", "w_f_source", "setup", "particles", "steps", "wall_s", "run_file", "error")
+                "slab_fracture_at", "w_f", "w_f_source", "setup", "particles", "steps", "threads", "wall_s", "run_file",
+                "error")
 
 
 def _write_outputs(out_dir: str, recs: list, refused: list) -> None:
