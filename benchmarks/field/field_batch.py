@@ -58,6 +58,7 @@ def main(argv=None) -> int:
     p.add_argument("--workers", type=int, default=None, help="Dask workers (default one per core)")
     p.add_argument("--threads", type=int, default=FieldProtocol.threads, help="CPU threads of each case (default 1)")
     p.add_argument("--max-particles", type=int, default=FieldProtocol.max_particles, help="per-case budget")
+    p.add_argument("--limit", type=int, default=None, help="run only the first N selected cases (a rate measurement)")
     p.add_argument("--no-measured", action="store_true",
                    help="leave out the measured-density columns (a first, small sample: the stratified part only)")
     args = p.parse_args(argv)
@@ -66,6 +67,8 @@ def main(argv=None) -> int:
     cases, refused = gather([args.data], calibrate=False)      # the selection's columns calibrate when built
     per, budget = (2, 30_000) if args.quick else (args.per_class, args.max_particles)
     chosen, counts = select(cases, per, args.seed, measured=not (args.quick or args.no_measured))
+    if args.limit is not None:
+        chosen = chosen[:max(1, args.limit)]
     runs = args.runs or tempfile.mkdtemp(prefix="mpm_warp_field_batch_")
     env = environment(args.device)
     t1 = time.perf_counter()
@@ -75,7 +78,7 @@ def main(argv=None) -> int:
     ok = [r for r in batch.records if r.get("status") == "ok"]
     data = {"name": "field_batch", "data": os.path.basename(os.path.normpath(args.data)), "environment": env,
             "selection": {"runnable": len(cases), "refused": len(refused), **counts, "seed": args.seed,
-                          "per_class": per, "max_particles": budget},
+                          "per_class": per, "max_particles": budget, "limit": args.limit},
             "workers": args.workers, "threads_per_case": args.threads,
             "scores": batch.scores, "batch_wall_s": wall, "setup_wall_s": t1 - t0,
             "cases_per_hour": 3600.0 * len(ok) / wall if wall > 0 and batch.skipped == 0 else None,

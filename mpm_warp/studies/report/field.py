@@ -62,11 +62,22 @@ def _recall(s: dict, c: str) -> str:
 CASE_BUDGET_S = 60.0
 
 
-def _batch_command(d: dict) -> str:
+def _batch_command(d: dict, out: str = "") -> str:
     sel = d["selection"]
     return (f"python benchmarks/field/field_batch.py DIR --runs RUNDIR --per-class {sel['per_class']} --seed "
             f"{sel['seed']}" + (" --no-measured" if not sel.get("measured") else "")
-            + (f" --workers {d['workers']}" if d.get("workers") else ""))
+            + (f" --workers {d['workers']}" if d.get("workers") else "")
+            + (f" --threads {d['threads_per_case']}" if d.get("threads_per_case", 1) != 1 else "")
+            + (f" --limit {sel['limit']}" if sel.get("limit") else "")
+            + (f" --out {out}" if out else ""))
+
+
+def _threads(n: int) -> str:
+    return "one thread" if n == 1 else f"{n} threads"
+
+
+def _command_to(out: str):
+    return lambda d: _batch_command(d, out)
 
 
 @section("field", "Field outcomes against the observers", "field/results/field_batch.json", _batch_command,
@@ -96,7 +107,8 @@ def render_batch(data: dict, ctx) -> list[str]:
             + (" (too few cases to tell: at least 50 per class are needed)" if sc["cases"] < 150 else "") + ".", "",
             f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time: {secs(med)}, "
             f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** (particle budget "
-            f"{count(sel['max_particles'])}, one thread per case, {data.get('workers') or 'one per core'} workers; "
+            f"{count(sel['max_particles'])}, {_threads(data.get('threads_per_case', 1))} per case, "
+            f"{data.get('workers') or 'one per core'} workers; "
             + (f"{fx(data['cases_per_hour'], 0)} cases per hour)." if data.get("cases_per_hour") else
                f"the {count(data['resumed_cases'])} cases were run by an earlier invocation of the same command, "
                "which this one found finished and scored: their wall times are that run's, on this shared machine "
@@ -111,3 +123,13 @@ def render_batch(data: dict, ctx) -> list[str]:
                 "What follows the runaway is the model's own."]
     out += ["", env_note(data)]
     return out
+
+
+section("field", "Field outcomes: every column with measured slab densities", "field/results/measured/field_batch.json",
+        _command_to("benchmarks/field/results/measured"),
+        question="On the records whose every slab density was measured in the pit (no density from hardness or "
+                 "grain), does the model predict the observed outcome?")(render_batch)
+
+section("field", "Field batch: one worker of two threads", "field/results/rate/field_batch.json",
+        _command_to("benchmarks/field/results/rate"), question="How long does a field case take, and how many cases "
+        "an hour does the batch run, with one Dask worker whose cases each step on both cores?")(render_batch)
