@@ -72,6 +72,12 @@ def _batch_command(d: dict, out: str = "") -> str:
             + (f" --out {out}" if out else ""))
 
 
+def _verdict(sc: dict, m, best: float) -> str:
+    if sc["cases"] < 150:
+        return "open"
+    return "pass" if m is not None and m > best else "fail"
+
+
 def _threads(n: int) -> str:
     return "one thread" if n == 1 else f"{n} threads"
 
@@ -103,8 +109,9 @@ def render_batch(data: dict, ctx) -> list[str]:
                                                     sc["weac_static"]["balanced_accuracy"] or 0.0)
     med = sc["wall_s"]["median"]
     out += ["", f"**Check:** the model's balanced accuracy above both baselines': {_ba(sc['model'])} against "
-            f"{best:.2f}, **{'pass' if m is not None and m > best else 'fail'}**"
-            + (" (too few cases to tell: at least 50 per class are needed)" if sc["cases"] < 150 else "") + ".", "",
+            f"{best:.2f}, **{_verdict(sc, m, best)}**"
+            + (" (too few cases to tell: at least 50 per class are needed; a balanced accuracy is over the observed "
+               "classes present)" if sc["cases"] < 150 else "") + ".", "",
             f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time: {secs(med)}, "
             f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** (particle budget "
             f"{count(sel['max_particles'])}, {_threads(data.get('threads_per_case', 1))} per case, "
