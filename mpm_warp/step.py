@@ -29,7 +29,7 @@ from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec
 from .meeting import MeetingPoint
 from .model import Model, State, material_params
-from .step_profile import stage_walls, timed
+from .step_profile import refuse_no_ops, stage_walls, timed
 
 __all__ = ["Stepper", "default_threads", "grid_copies"]
 
@@ -324,24 +324,15 @@ class Stepper:
         Returns ``serial`` (thread 0's launches outside the parallel stages, per step), and for ``p2g``,
         ``grid`` and ``g2p``: ``wall`` (meeting to meeting on thread 0, synchronisation included) and
         ``busy`` (each thread's own launches): ``wall - max(busy)`` is the cost of the meeting and of the
-        imbalance. The clock is advanced as by :meth:`steps`.
-
-        Steps at the frame end are no-ops (``dt = 0``) that would time as fast: a profile that meets the frame end
-        (``clock[2]``; :meth:`set_frame_end` moves it) raises ``RuntimeError`` rather than return their times.
+        imbalance. The clock is advanced as by :meth:`steps`; one that meets the frame end raises (no-op steps).
         """
-        self._refuse_no_ops("before")
+        refuse_no_ops(self.state.clock, "before")
         record: list = []
         t0 = time.perf_counter()
         self._team_steps(n, record)
         wall = time.perf_counter() - t0
-        self._refuse_no_ops("during")
+        refuse_no_ops(self.state.clock, "during")
         return stage_walls(record, n, self.n_threads, wall)
-
-    def _refuse_no_ops(self, when: str) -> None:
-        t, _, t_end, _ = (float(c) for c in self.state.clock.numpy()[:4])
-        if t >= t_end * (1.0 - 1e-12) - 1e-15:
-            raise RuntimeError(f"Stepper.profile: the clock reached its frame end t = {t_end:g} s {when} the profiled "
-                               "steps, so they time no-op steps (dt = 0): call set_frame_end(t) with a t beyond them")
 
     def steps(self, n: int) -> None:
         """Launch ``n`` steps without any host synchronisation.

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 
-__all__ = ["stage_walls", "timed", "STAGES"]
+__all__ = ["stage_walls", "timed", "refuse_no_ops", "STAGES"]
 
 #: the parallel stages of a step, in order
 STAGES = ("p2g", "grid", "g2p")
@@ -63,3 +63,12 @@ def stage_walls(record: list, n: int, n_threads: int, total: float) -> dict:
     for s in STAGES:
         out[s] = {"wall": walls[s], "busy": busy[s]}
     return out
+
+
+def refuse_no_ops(clock, when: str) -> None:
+    """Raise ``RuntimeError`` when ``clock`` (the step's ``[t, dt, t_end, dt_last]``, s) is at its frame end: the
+    steps ``when`` ("before" or "during") a profile are then no-ops (dt = 0) that would time as fast."""
+    t, _, t_end, _ = (float(c) for c in clock.numpy()[:4])
+    if t >= t_end * (1.0 - 1e-12) - 1e-15:
+        raise RuntimeError(f"Stepper.profile: the clock reached its frame end t = {t_end:g} s {when} the profiled "
+                           "steps, so they time no-op steps (dt = 0): call set_frame_end(t) with a t beyond them")
