@@ -2,7 +2,8 @@
 
 Sets up every PST record of a folder of pits (the development set, docs/profiles.md), selects the runnable
 columns whose slab densities were all measured and a sample stratified by the observed class (``--per-class``
-of each of END, SF and ARR, drawn with ``--seed``, from the rest), and runs them by the field protocol on Dask
+of each of END, SF and ARR, drawn with ``--seed``, from the rest; the classes interleaved, so that the first
+N cases of a run stopped early are stratified too), and runs them by the field protocol on Dask
 (``mpm_warp.field.batch``, resumable: the runs stay in ``--runs``). Writes ``benchmarks/field/results/
 field_batch.json``: the selection, the scores of the model and of both baselines (confusion matrix, recall
 per class, balanced accuracy), the cost per case (median wall time, particles, steps) and the batch's rate.
@@ -41,11 +42,14 @@ def select(cases, per_class: int, seed: int, measured: bool = True) -> tuple[lis
     rest = [c for c in cases if not (measured and all_measured(c))]
     rng = random.Random(seed)
     counts = {"measured": len(chosen)}
+    takes = []
     for cls in ("END", "SF", "ARR"):
         pool = [c for c in rest if field_class(c.outcome) == cls]
-        take = rng.sample(pool, min(per_class, len(pool)))
-        counts[cls] = len(take)
-        chosen += take
+        takes.append(rng.sample(pool, min(per_class, len(pool))))
+        counts[cls] = len(takes[-1])
+    # the classes interleaved (END, SF, ARR, END, ...): the cases run in this order, so the first N of a run
+    # stopped early (or of --limit N) are as stratified as N allows
+    chosen += [t[k] for k in range(max(map(len, takes), default=0)) for t in takes if k < len(t)]
     return chosen, counts
 
 
