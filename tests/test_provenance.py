@@ -108,7 +108,6 @@ KNOWN_DIRTY = {
     "perf/results/return_cost_cpu.json": "python benchmarks/perf/return_cost.py",
     "perf/results/throughput_cpu.json": "python benchmarks/perf/throughput.py --device cpu",
     "robustness/results/disk_full.json": "sudo .venv/bin/python benchmarks/robustness/disk_full.py",
-    "snow/results/interface_stress_cpu.json": "python benchmarks/snow/interface_stress.py",
     "snow/results/pst_outcomes.json": "python benchmarks/snow/pst_outcomes.py",                # ~40 min
     "snow/results/shear_free_ends_cpu.json": "python benchmarks/snow/shear_free_ends.py",
     "snow/results/snow_critical_cut.json":

@@ -117,9 +117,9 @@ def render_batch(data: dict, ctx) -> list[str]:
             f"{count(sel['max_particles'])}, {_threads(data.get('threads_per_case', 1))} per case, "
             f"{data.get('workers') or 'one per core'} workers; "
             + (f"{fx(data['cases_per_hour'], 0)} cases per hour)." if data.get("cases_per_hour") else
-               f"the {count(data['resumed_cases'])} cases were run by an earlier invocation of the same command, "
-               "which this one found finished and scored: their wall times are that run's, on this shared machine "
-               "while another benchmark ran beside the two workers, so they are upper bounds).")]
+               f"{count(data['resumed_cases'])} cases were run by earlier invocations of the same command (a batch "
+               "stopped and resumed), which this one found finished and scored: the batch's rate is not measured "
+               "here; each case's wall time is its own run's, on this shared machine).")]
     read = [c for c in data.get("cases", []) if c.get("w_f_source") == "read back" and c.get("runaway_cut")
             and c.get("recorded_cut")]
     if read:
