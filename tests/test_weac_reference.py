@@ -68,6 +68,28 @@ def test_critical_cut_is_the_root_of_a_direct_weac_call(ours, theirs):
     assert wr.critical_cut(column(*ours), W_F) == pytest.approx(want, rel=1e-6)
 
 
+def arr_column():
+    """pst_outcomes.py's ARR column: pst_demo's 2.5 m, 0.3 m slab on a 3 cm weak layer."""
+    return wr.StaticColumn(slab=[(0.3, 250.0, 5.0e6, 0.3)], weak_layer_thickness=0.03, weak_layer_E=1.0e6,
+                           weak_layer_nu=0.3, length=2.5)
+
+
+def test_touchdown_caps_G_of_a_long_crack():
+    """weac with touchdown (the cut slab's end rests on the collapsed layer): below the cut at which the end
+    touches, the same G as without; past it G stops growing. Values of weac 2.6.4's touchdown=True, which weac
+    3.3.1 repeats to 1e-4 (checked by hand at 0.8-2.4 m)."""
+    col = arr_column()
+    for a in (0.3, 0.5, 0.7):                 # free-hanging: touchdown changes nothing
+        assert wr.energy_release_rate(col, a, touchdown=True) == pytest.approx(wr.energy_release_rate(col, a),
+                                                                               rel=1e-9)
+    free = [wr.energy_release_rate(col, a)[0] for a in (0.8, 0.95, 1.5)]
+    capped = [wr.energy_release_rate(col, a, touchdown=True)[0] for a in (0.8, 0.95, 1.5)]
+    assert free == pytest.approx([5.633, 9.840, 47.40], rel=1e-3)       # grows without bound as the slab hangs
+    assert capped == pytest.approx([2.897, 2.700, 3.525], rel=1e-3)     # rests on the layer: about 3 G_c
+    G, G_I, G_II = wr.energy_release_rate(col, 0.8, touchdown=True)
+    assert G == pytest.approx(G_I + G_II, rel=1e-12) and (G_I, G_II) == pytest.approx((2.240, 0.6573), rel=1e-3)
+
+
 def test_installed_weac_rounds_to_the_values_recorded_from_weac_3_3_1():
     """The installed weac (2.6 here) computes the ladder PST's critical cuts; they round to the values recorded
     from weac 3.3.1 (``WEAC_3_3_1_RECORDED`` of ``benchmarks/snow/weac_static_pst.py``: computed outside this

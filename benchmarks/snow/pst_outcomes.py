@@ -13,7 +13,9 @@ tensile strength and fracture energy from each layer's density, docs/model.md §
 
 For the SF column the slab's break position is compared with where weac's static solution of the same
 column at the same cut (the saw's position when the slab broke) puts the slab's largest tensile stress
-(:func:`mpm_warp.scenes.weac_reference.slab_stress`). Writes ``results/pst_outcomes.json`` and one picture
+(:func:`mpm_warp.scenes.weac_reference.slab_stress`); for the ARR column, weac's energy release rate with
+touchdown along the crack's path from the saw on (does a static balance with the slab resting on the
+collapsed layer stop the crack, and where). Writes ``results/pst_outcomes.json`` and one picture
 per column, ``results/pst_outcome_<class>.png`` (:func:`mpm_warp.post.pst_picture.pst_picture`).
 
 Usage::
@@ -30,12 +32,14 @@ import os
 import sys
 import time
 
+import numpy as np
+
 import mpm_warp as mw
 from mpm_warp.finite_json import load_json
 from mpm_warp.post.pst_picture import pst_picture
 from mpm_warp.scenes.pst.static import static_column
 from mpm_warp.scenes.snowpack import SnowLayer
-from mpm_warp.scenes.weac_reference import slab_stress, weac_unavailable
+from mpm_warp.scenes.weac_reference import energy_release_rate, slab_stress, weac_unavailable
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -83,6 +87,23 @@ def weac_break(sc: mw.Scenario, outcome: dict, times, saw) -> dict:
                     "(docs/weac.md)"}
 
 
+def weac_touchdown(sc: mw.Scenario, outcome: dict, step: float = 0.05) -> dict:
+    """weac's G with touchdown along the crack's path, from the saw's cut to near the far end: where, if anywhere,
+    a static energy balance with the slab resting on the collapsed layer stops the crack (G < G_c = w_f)."""
+    if weac_unavailable() is not None:
+        return {"weac": None, "note": weac_unavailable()}
+    p = sc.scene
+    col, G_c, L = static_column(p), float(p.weak_layer.w_f), float(p.length)
+    cuts = sorted({round(float(a), 6) for a in np.arange(outcome["cut"], 0.96 * L, step)} | {outcome["arrest_at"]})
+    G = [energy_release_rate(col, a, touchdown=True)[0] for a in cuts]
+    k = int(np.argmin(G))
+    stop = next((a for a, g in zip(cuts, G, strict=True) if g < G_c), None)
+    return {"G_c": G_c, "cuts": cuts, "G": G, "G_min": G[k], "G_min_at": cuts[k],
+            "G_at_arrest": G[cuts.index(outcome["arrest_at"])], "arrest_at": stop,
+            "note": "weac's differential G (J/m^2) with touchdown (weac's collapse height) at cuts (m) from the cut "
+                    "end; arrest_at: the first cut past the saw where G < G_c, None if G stays above it"}
+
+
 def run_case(name: str, folder: str, device: str) -> dict:
     overrides, layers, what = QUICK if name == "quick" else CASES[name]
     sc = scenario(overrides, layers)
@@ -106,6 +127,8 @@ def run_case(name: str, folder: str, device: str) -> dict:
            "environment": environment(device)}
     if o["class"] == "SF":
         out["weac_slab_stress"] = weac_break(sc, o, run.times, run.scalars["saw"])
+    if o["class"] == "ARR" and o.get("arrest_at") is not None:
+        out["weac_touchdown"] = weac_touchdown(sc, o)
     os.remove(path)          # the run file is large; the picture and the JSON are what the results keep
     print(f"{name}: {o['field_line']} ({wall:.0f} s); {o.get('note', '')}", flush=True)
     return out

@@ -163,11 +163,12 @@ def _plate_stiffness(column: StaticColumn) -> tuple[float, float, float, float]:
             float(np.sum(Ep * np.diff(z**3)) / 3.0), float(_KAPPA * np.sum(G * np.diff(z))))
 
 
-def _model(column: StaticColumn):
-    """weac's ``Layered`` model of ``column`` (mm, MPa), each layer's E and nu as given (not weac's E(rho))."""
+def _model(column: StaticColumn, touchdown: bool = False):
+    """weac's ``Layered`` model of ``column`` (mm, MPa), each layer's E and nu as given (not weac's E(rho));
+    ``touchdown``: the cut slab's end may rest on the collapsed weak layer (weac's own collapse height)."""
     weac = _weac()
     system, _ = weac_setup(column)
-    model = weac.Layered(system=system, layers=[[ly[1], ly[0] * 1e3] for ly in column.slab])
+    model = weac.Layered(system=system, layers=[[ly[1], ly[0] * 1e3] for ly in column.slab], touchdown=touchdown)
     model.set_foundation_properties(t=column.weak_layer_thickness * 1e3, E=column.weak_layer_E * 1e-6,
                                     nu=column.weak_layer_nu)
     E = np.array([ly[2] for ly in column.slab]) * 1e-6
@@ -195,23 +196,25 @@ class _Solved:
     left: bool            # the cut end is weac's x = 0
 
 
-def _solve(column: StaticColumn, cut: float, model=None) -> _Solved:
+def _solve(column: StaticColumn, cut: float, model=None, touchdown: bool = False) -> _Solved:
     """Solve ``column`` with a cut of ``cut`` m from its cut end (``model``: reuse a built one)."""
     finite_number("cut", cut, lo=0.0, hi=column.length, hi_open=True)
-    model = _model(column) if model is None else model
+    model = _model(column, touchdown) if model is None else model
     system, phi = weac_setup(column)
     seg = model.calc_segments(L=column.length * 1e3, a=float(cut) * 1e3, phi=phi)["crack"]
     C = model.assemble_and_solve(phi=phi, **seg)
     return _Solved(model, phi, seg, C, system.startswith("-"))
 
 
-def energy_release_rate(column: StaticColumn, cut: float) -> tuple[float, float, float]:
+def energy_release_rate(column: StaticColumn, cut: float, touchdown: bool = False) -> tuple[float, float, float]:
     """weac's differential energy release rate ``(G, G_I, G_II)`` (J/m^2) at a cut of ``cut`` m.
 
     ``cut`` is measured along the weak layer from the cut end, in [0, length). ``G = G_I + G_II`` at the crack
-    tip (weac's ``gdif``), from the weak layer's normal and shear stress there.
+    tip (weac's ``gdif``), from the weak layer's normal and shear stress there. ``touchdown``: with weac's
+    touchdown (the cut slab's end rests on the collapsed layer once it sinks by weac's collapse height, and
+    then lies on it; Rosendahl et al. 2025): the G of a crack long past the critical cut, capped.
     """
-    s = _solve(column, cut)
+    s = _solve(column, cut, touchdown=touchdown)
     return tuple(float(g) for g in s.model.gdif(s.C, s.phi, **s.seg, unit="J/m^2"))
 
 
