@@ -108,7 +108,6 @@ KNOWN_DIRTY = {
     "perf/results/return_cost_cpu.json": "python benchmarks/perf/return_cost.py",
     "perf/results/throughput_cpu.json": "python benchmarks/perf/throughput.py --device cpu",
     "robustness/results/disk_full.json": "sudo .venv/bin/python benchmarks/robustness/disk_full.py",
-    "snow/results/pst_outcomes.json": "python benchmarks/snow/pst_outcomes.py",                # ~40 min
     "snow/results/snow_critical_cut.json":
         "python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope",   # hours
     "snow/results/snow_long_speed_trends.json": "python benchmarks/snow/long_speed_trends.py",   # hours
