@@ -68,4 +68,29 @@ def test_the_arrest_beyond_weacs_critical_cut_is_a_visible_fail_with_touchdown_a
            "outcome": {"cut": 0.8, "arrest_at": 1.0125}}
     start, arrest = [ln for ln in outcome_checks({"ARR": arr}) if ln]
     assert "**pass**" in start and "ran 0.21 m beyond" in start
-    assert "**FAIL**" in arrest and "4.7 G_c" in arrest and "touchdown" in arrest and "open" in arrest
+    assert "**FAIL**" in arrest and "4.7 G_c" in arrest and "touchdown" in arrest and "not computed" in arrest
+
+
+def test_the_arrest_is_held_to_weac_with_touchdown_within_one_slab_thickness():
+    arr = {"weac": {"critical_cut": 0.478, "G_c": 1.2, "energy_release_rate": 5.63},
+           "outcome": {"cut": 0.8, "arrest_at": 1.0125}, "slab_layers": [{"thickness": 0.3}],
+           "weac_touchdown": {"G_c": 1.2, "G_min": 2.70, "G_min_at": 0.95, "G_at_arrest": 2.73, "arrest_at": None}}
+    arrest = [ln for ln in outcome_checks({"ARR": arr}) if ln][1]
+    assert "**FAIL**" in arrest and "with touchdown" in arrest and "2.25 G_c" in arrest and "says END" in arrest
+    for stop, verdict in ((1.25, "**pass**"), (1.35, "**FAIL**")):       # 0.24 m and 0.34 m from the MPM's 1.01 m
+        arr["weac_touchdown"]["arrest_at"] = stop
+        arrest = [ln for ln in outcome_checks({"ARR": arr}) if ln][1]
+        assert verdict in arrest and f"weac stops it at {stop:.2f} m" in arrest
+
+
+def test_a_critical_cut_change_inside_its_brackets_is_not_called_converged():
+    from mpm_warp.studies.report.convergence import _bracketed
+
+    lv = [{"critical_cut": 0.353, "critical_cut_bracket": [0.34375, 0.3625]},
+          {"critical_cut": 0.334, "critical_cut_bracket": [0.325, 0.34375]},
+          {"critical_cut": 0.334, "critical_cut_bracket": [0.325, 0.34375]}]
+    s = {"time_to": {"5%": {"wall_time_s": 1837.0, "status": "met"}, "1%": {"wall_time_s": 1837.0, "status": "met"}}}
+    chg, errs, times = _bracketed(lv, s, ["5.6 %", "0.0 %", "0.0 %"], ["5%", "1%"])
+    assert chg == "-5.4 %, 0.0 % (brackets overlap: not resolved)"       # adjacent brackets resolve -5.4 %
+    assert errs == ["5.6 %", "0.0 %: not resolved (brackets overlap)", "reference (bracket +/-2.8 %)"]
+    assert times[0].startswith("1,837 s") and times[1] == "not resolved: the finest bracket is +/-2.8 %"

@@ -113,6 +113,39 @@ def _changes(values) -> str:
     return ", ".join(spct(c) for c in ch) if ch else DASH
 
 
+def _overlap(a: dict, b: dict) -> bool:
+    """The two levels' critical-cut brackets share more than an end point: their change is not resolved."""
+    (a0, a1), (b0, b1) = a["critical_cut_bracket"], b["critical_cut_bracket"]
+    return max(a0, b0) < min(a1, b1) - 1e-9 * abs(min(a1, b1))   # (a shared end point, in round-off, is not)
+
+
+def _half_width(rec: dict) -> float:
+    lo, hi = rec["critical_cut_bracket"]
+    return 0.5 * (hi - lo) / rec["critical_cut"]
+
+
+def _bracketed(levels: list[dict], s: dict, errs: list[str], targets) -> tuple[str, list[str], list[str]]:
+    """The critical cut's changes, errors and times to each error where its bisection brackets decide them: a
+    change between levels whose brackets overlap is not resolved, nor an error below the finest's half width."""
+    runs = [r for r in levels if finite(r.get("critical_cut"))]
+    ch = [spct(b["critical_cut"] / a["critical_cut"] - 1.0) + (" (brackets overlap: not resolved)"
+                                                                 if _overlap(a, b) else "")
+          for a, b in zip(runs, runs[1:], strict=False)]
+    fin = runs[-1] if runs else None
+    out = []
+    for r, e in zip(levels, errs, strict=True):
+        if fin is None or not finite(r.get("critical_cut")):
+            out.append(e)
+        elif r is fin:
+            out.append(f"reference (bracket +/-{pct(_half_width(fin))})")
+        else:
+            out.append(f"{e}: not resolved (brackets overlap)" if _overlap(r, fin) else e)
+    hw = _half_width(fin) if fin else None
+    times = [f"not resolved: the finest bracket is +/-{pct(hw)}" if hw is not None and hw > float(k.rstrip("%")) / 100
+             else _time_to(s["time_to"].get(k)) for k in targets]
+    return ", ".join(ch) if ch else DASH, out, times
+
+
 def _cells(rec: dict) -> str:
     return f"{rec['cells_across_layer']:g} cells"
 
@@ -134,11 +167,12 @@ def render_ladder(data: dict, name: str) -> list[str]:
             continue
         use_rich = s.get("reference_used_for_time_to") == "richardson"
         rich = fx(s.get("richardson"), spec[3], spec[1], spec[2])
-        rows.append([spec[0], *[_value(r, key, spec) for r in levels], _changes(s["values"]),
-                     fx(s.get("observed_order"), 2), rich])
-        e = s["error_vs_richardson"] if use_rich else s["error_vs_finest"]
-        errs.append([spec[0], *[pct(x) for x in e], "extrapolated " + rich if use_rich else "the finest level",
-                     *[_time_to(s["time_to"].get(k)) for k in targets]])
+        e = [pct(x) for x in (s["error_vs_richardson"] if use_rich else s["error_vs_finest"])]
+        chg, times = _changes(s["values"]), [_time_to(s["time_to"].get(k)) for k in targets]
+        if key == "critical_cut" and not use_rich:
+            chg, e, times = _bracketed(levels, s, e, targets)
+        rows.append([spec[0], *[_value(r, key, spec) for r in levels], chg, fx(s.get("observed_order"), 2), rich])
+        errs.append([spec[0], *e, "extrapolated " + rich if use_rich else "the finest level", *times])
     out += table(["quantity", *heads, "changes per halving", "observed order", "extrapolated"], rows)
     growing = [QUANTITIES[name][k][0] for k, s in summ.items() if k in QUANTITIES[name]
                and len(changes(s["values"])) >= 2

@@ -137,6 +137,26 @@ section("field", "Field outcomes: every column with measured slab densities", "f
         question="On the records whose every slab density was measured in the pit (no density from hardness or "
                  "grain), does the model predict the observed outcome?")(render_batch)
 
-section("field", "Field batch: one worker of two threads", "field/results/rate/field_batch.json",
-        _command_to("benchmarks/field/results/rate"), question="How long does a field case take, and how many cases "
-        "an hour does the batch run, with one Dask worker whose cases each step on both cores?")(render_batch)
+MEASURED = "field/results/measured/field_batch.json"
+
+
+@section("field", "Field batch: one worker of two threads", "field/results/rate/field_batch.json",
+         _command_to("benchmarks/field/results/rate"), question="How long does a field case take, and how many cases "
+         "an hour does the batch run, with one Dask worker whose cases each step on both cores?")
+def render_rate(data: dict, ctx) -> list[str]:
+    """:func:`render_batch`, and the same cases against their run in the measured-density batch (2 workers of one
+    thread): each case's wall time there over here."""
+    out = render_batch(data, ctx)
+    other = ctx.load(MEASURED) or {}
+    there = {c["id"]: c for c in other.get("cases", []) if c.get("status") == "ok"}
+    pairs = [(there[c["id"]]["wall_s"], c["wall_s"]) for c in data.get("cases", [])
+             if c.get("status") == "ok" and c["id"] in there]
+    if pairs:
+        r = sorted(a / b for a, b in pairs)
+        med = r[len(r) // 2] if len(r) % 2 else 0.5 * (r[len(r) // 2 - 1] + r[len(r) // 2])
+        out[-1:-1] = [f"- **Against two workers of one thread:** the same {len(pairs)} cases took "
+                      f"{', '.join(secs(a) for a, _ in pairs)} each in the measured-density batch (2 workers of one "
+                      f"thread, {fx(other.get('cases_per_hour'), 0)} cases an hour over its "
+                      f"{count(other['scores']['cases'])} cases) and {', '.join(secs(b) for _, b in pairs)} here: each "
+                      f"case {fx(med, 2)}x sooner (median; {fx(r[0], 2)}-{fx(r[-1], 2)}x).", ""]
+    return out
