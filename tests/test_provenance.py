@@ -103,10 +103,7 @@ def test_a_full_run_from_a_dirty_tree_is_refused_before_it_starts(monkeypatch, t
 KNOWN_DIRTY = {
     "convergence/results/error_vs_runtime_snow.json":
         "python benchmarks/convergence/error_vs_runtime_snow.py",            # both ladders, hours
-    "perf/results/bonded_return_cost_cpu.json": "python benchmarks/perf/bonded_return_cost.py --device cpu",
     "perf/results/pst_scaling_cpu.json": "python benchmarks/perf/pst_scaling.py",
-    "perf/results/return_cost_cpu.json": "python benchmarks/perf/return_cost.py",
-    "perf/results/throughput_cpu.json": "python benchmarks/perf/throughput.py --device cpu",
     "robustness/results/disk_full.json": "sudo .venv/bin/python benchmarks/robustness/disk_full.py",
     "snow/results/snow_critical_cut.json":
         "python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope",   # hours
