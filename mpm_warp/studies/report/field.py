@@ -82,6 +82,14 @@ def _threads(n: int) -> str:
     return "one thread" if n == 1 else f"{n} threads"
 
 
+def _workers(n) -> str:
+    return "one worker per core" if not n else f"{n} worker{'s' if n != 1 else ''}"
+
+
+def _cases(n: int) -> str:
+    return "the one case" if n == 1 else f"the {n} cases"
+
+
 def _command_to(out: str):
     return lambda d: _batch_command(d, out)
 
@@ -115,7 +123,7 @@ def render_batch(data: dict, ctx) -> list[str]:
             f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time: {secs(med)}, "
             f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** (particle budget "
             f"{count(sel['max_particles'])}, {_threads(data.get('threads_per_case', 1))} per case, "
-            f"{data.get('workers') or 'one per core'} workers; "
+            f"{_workers(data.get('workers'))}; "
             + (f"{fx(data['cases_per_hour'], 0)} cases per hour)." if data.get("cases_per_hour") else
                f"{count(data['resumed_cases'])} cases were run by earlier invocations of the same command (a batch "
                "stopped and resumed), which this one found finished and scored: the batch's rate is not measured "
@@ -124,8 +132,9 @@ def render_batch(data: dict, ctx) -> list[str]:
             and c.get("recorded_cut")]
     if read:
         d = [c["runaway_cut"] / c["recorded_cut"] - 1.0 for c in read]
-        out += ["", f"- **Where the crack ran away:** in the {len(read)} cases whose fracture energy was read back "
-                f"from the recorded cut (weac's G there), the run's runaway cut is {spct(min(d))} to {spct(max(d))} "
+        span = spct(d[0]) if len(d) == 1 else f"{spct(min(d))} to {spct(max(d))}"
+        out += ["", f"- **Where the crack ran away:** in {_cases(len(read))} whose fracture energy was read back "
+                f"from the recorded cut (weac's G there), the run's runaway cut is {span} "
                 "off the recorded one, where weac's energy criterion puts it exactly (it gave the fracture energy). "
                 "What follows the runaway is the model's own."]
     out += ["", env_note(data)]
