@@ -169,3 +169,25 @@ def render_rate(data: dict, ctx) -> list[str]:
                       f"{count(other['scores']['cases'])} cases) and {', '.join(secs(b) for _, b in pairs)} here: each "
                       f"case {fx(med, 2)}x sooner (median; {fx(r[0], 2)}-{fx(r[-1], 2)}x).", ""]
     return out
+
+
+def _group_row(name: str, g: dict) -> list[str]:
+    ratio = (f"{fx(g['runaway_over_recorded'], 2)} ({g['runaway_over_recorded_cases']})"
+             if g.get("runaway_over_recorded") is not None else "-")
+    return [name, count(g["cases"]), fx(g["slab_depth_m"], 0, 100), fx(g["slab_density"], 0), fx(g["slope_deg"], 0),
+            pct(g["cut_share"], 0) if g.get("cut_share") is not None else "-", count(g["w_f_read_back"]), ratio,
+            f"{g['slab_cracked']} of {g['slab_checked']}", count(g["weac_static_SF"])]
+
+
+@section("field", "Where the model and the observers disagree", "field/results/field_disagreements.json",
+         lambda d: f"python benchmarks/field/disagreements.py RUNDIR DIR  # RUNDIR: the runs of {d['runs']}",
+         question="What do the columns the model gets wrong have in common (docs/field.md)?")
+def render_disagreements(data: dict, ctx) -> list[str]:
+    heads = ["observed -> predicted", "cases", "slab depth (cm)", "slab density (kg/m^3)", "slope (deg)",
+             "cut / column", "w_f read back", "runaway / recorded cut (cases)", "slab cracked", "weac static: SF"]
+    rows = [_group_row(f"{k} (all)", g) for k, g in data["by_observed"].items() if g["cases"]]
+    rows += [_group_row(k.replace("->", " -> "), g) for k, g in data["by_pair"].items()]
+    return (["Medians over each group of the batch's scored cases; counts where a column is a count. The slab cracked: "
+             "its largest effective tensile stress reached its strength somewhere (kappa, docs/model.md §9), "
+             "whether or not it broke through.", ""]
+            + table(heads, rows) + ["", env_note(data, verb="computed")])

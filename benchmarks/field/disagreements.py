@@ -1,0 +1,113 @@
+"""Where do the model and the observers disagree, and what do those columns have in common?
+
+Reads a field batch's runs (``field_batch.py --runs RUNDIR``) and the pits they came from, and describes each
+scored case by what the observer recorded and what the run did: the slab's bed-normal depth and mean density,
+the slope, the cut as a share of the column, where the weak layer's fracture energy came from (read back from
+the recorded cut, or the default), the run's runaway cut against the recorded one, and whether the slab
+cracked anywhere (its largest effective tensile stress over its strength, from the final checkpoint: ``kappa``,
+docs/model.md §9). Groups them by observed and predicted class. Nothing here changes the model: it is the
+evidence for which physics is missing. Writes ``benchmarks/field/results/field_disagreements.json``.
+
+Usage: ``python benchmarks/field/disagreements.py RUNDIR DIR [--out OUT]``  (DIR: the unpacked pits).
+``--quick``: the first six cases only.
+"""
+
+from __future__ import annotations
+
+import glob
+import json
+import os
+import statistics
+import sys
+import warnings
+
+from mpm_warp.field.batch import gather
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+
+
+def slab_cracked(run_dir: str, case_id: str) -> float | None:
+    """The slab's largest ``kappa / tensile strength`` at the end of the run (>= 1: it cracked somewhere); None
+    without a checkpoint."""
+    import h5py
+
+    from mpm_warp.io.checkpoint import read_checkpoint_meta
+    from mpm_warp.loader import resolved_scenario
+    from mpm_warp.model import Model
+
+    ck = os.path.join(run_dir, case_id + ".ckpt.h5")
+    if not os.path.exists(ck):
+        return None
+    model = Model(resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck), "cpu")
+    with h5py.File(ck, "r") as f:
+        kappa = f["kappa"][:] if "kappa" in f else None
+    groups = [g for g in model.groups if g.material.model == "tensile_cracking"]
+    if kappa is None or not groups:
+        return None
+    return max(float(kappa[g.kappa_start:g.kappa_start + g.count].max()) / g.material.tensile_strength
+               for g in groups)
+
+
+def describe(rec: dict, case, run_dir: str) -> dict:
+    """One scored case: the observer's column and the run's outcome."""
+    p, slab = case.params, case.column.slab
+    depth = sum(ly.thickness for ly in slab)
+    return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "predicted": rec["predicted"],
+            "static_class": rec.get("static_class"), "slab_depth_m": p.slab_depth,
+            "slab_density": sum(ly.thickness * ly.density for ly in slab) / depth, "slope_deg": p.slope_angle,
+            "column_m": p.length, "cut_share": rec["recorded_cut"] / p.length, "column_ends": p.column_ends,
+            "w_f": rec["w_f"], "w_f_read_back": rec.get("w_f_source") == "read back",
+            "recorded_cut": rec["recorded_cut"], "runaway_cut": rec.get("runaway_cut"),
+            "slab_fracture_at": rec.get("slab_fracture_at"), "slab_crack_ratio": slab_cracked(run_dir, rec["id"])}
+
+
+def _median(xs):
+    xs = [x for x in xs if x is not None]
+    return statistics.median(xs) if xs else None
+
+
+def group(rows: list[dict]) -> dict:
+    """Counts and medians of one group of cases."""
+    ratio = [r["runaway_cut"] / r["recorded_cut"] for r in rows if r["runaway_cut"] and r["w_f_read_back"]]
+    cracked = [r for r in rows if r["slab_crack_ratio"] is not None]
+    return {"cases": len(rows), "slab_depth_m": _median([r["slab_depth_m"] for r in rows]),
+            "slab_density": _median([r["slab_density"] for r in rows]),
+            "slope_deg": _median([r["slope_deg"] for r in rows]), "cut_share": _median([r["cut_share"] for r in rows]),
+            "w_f_read_back": sum(r["w_f_read_back"] for r in rows),
+            "runaway_over_recorded": _median(ratio), "runaway_over_recorded_cases": len(ratio),
+            "slab_cracked": sum(r["slab_crack_ratio"] >= 1.0 for r in cracked), "slab_checked": len(cracked),
+            "weac_static_SF": sum(r["static_class"] == "SF" for r in rows)}
+
+
+def main(argv=None) -> int:
+    p = parser(__doc__, "the first six cases")
+    p.add_argument("runs", help="the field batch's runs folder (field_batch.py --runs)")
+    p.add_argument("data", help="folder of CAAML files the batch read")
+    args = p.parse_args(argv)
+    warnings.filterwarnings("ignore")
+    recs = []
+    for path in sorted(glob.glob(os.path.join(args.runs, "*.json"))):
+        with open(path) as fh:
+            r = json.load(fh)
+        if r.get("status") == "ok" and r.get("observed") and "predicted" in r:
+            recs.append(r)
+    recs = recs[:6] if args.quick else recs
+    cases, _ = gather([os.path.join(args.data, p) for p in sorted({r["pit"] for r in recs})], calibrate=False)
+    by = {(c.pit, c.test): c for c in cases}
+    rows = [describe(r, by[(r["pit"], r["test"])], args.runs) for r in recs if (r["pit"], r["test"]) in by]
+    classes = ("END", "SF", "ARR")
+    data = {"name": "field_disagreements", "runs": os.path.basename(os.path.normpath(args.runs)),
+            "data": os.path.basename(os.path.normpath(args.data)), "environment": environment("cpu"),
+            "by_observed": {c: group([r for r in rows if r["observed"] == c]) for c in classes},
+            "by_pair": {f"{o}->{q}": group(g) for o in classes for q in sorted({r["predicted"] for r in rows})
+                        if (g := [r for r in rows if r["observed"] == o and r["predicted"] == q])},
+            "cases": rows}
+    path = write_json("field_disagreements", data, out_dir(args, RESULTS, "field_disagreements"))
+    print(f"{path}: {len(rows)} cases")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
