@@ -8,7 +8,7 @@ cracked anywhere (its largest effective tensile stress over its strength, from t
 docs/model.md §9). Groups them by observed and predicted class. Nothing here changes the model: it is the
 evidence for which physics is missing. Writes ``benchmarks/field/results/field_disagreements.json``.
 
-Usage: ``python benchmarks/field/disagreements.py RUNDIR DIR [--out OUT]``  (DIR: the unpacked pits).
+Usage: ``python benchmarks/field/disagreements.py RUNDIR [RUNDIR ...] --data DIR``  (DIR: the unpacked pits).
 ``--quick``: the first six cases only.
 """
 
@@ -28,9 +28,10 @@ from mpm_warp.studies.protocol import out_dir, parser
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 
-def slab_cracked(run_dir: str, case_id: str) -> float | None:
-    """The slab's largest ``kappa / tensile strength`` at the end of the run (>= 1: it cracked somewhere); None
-    without a checkpoint."""
+def from_checkpoint(run_dir: str, case_id: str) -> tuple[float | None, float | None]:
+    """From the run's final checkpoint: the slab's largest ``kappa / tensile strength`` (>= 1: it cracked
+    somewhere), and the fastest material's P-wave speed over the slab's fastest (> 1: the substratum, not the
+    slab, sets the time step); Nones without a checkpoint."""
     import h5py
 
     from mpm_warp.io.checkpoint import read_checkpoint_meta
@@ -39,28 +40,36 @@ def slab_cracked(run_dir: str, case_id: str) -> float | None:
 
     ck = os.path.join(run_dir, case_id + ".ckpt.h5")
     if not os.path.exists(ck):
-        return None
-    model = Model(resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck), "cpu")
+        return None, None
+    sc = resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck)
+    model = Model(sc, "cpu")
+    c_p = {name: m.p_wave_speed for name, m in sc.materials.items()}
+    slab = max((v for k, v in c_p.items() if k.startswith("slab")), default=None)
+    dt_ratio = max(c_p.values()) / slab if slab else None
     with h5py.File(ck, "r") as f:
         kappa = f["kappa"][:] if "kappa" in f else None
     groups = [g for g in model.groups if g.material.model == "tensile_cracking"]
     if kappa is None or not groups:
-        return None
+        return None, dt_ratio
     return max(float(kappa[g.kappa_start:g.kappa_start + g.count].max()) / g.material.tensile_strength
-               for g in groups)
+               for g in groups), dt_ratio
 
 
 def describe(rec: dict, case, run_dir: str) -> dict:
     """One scored case: the observer's column and the run's outcome."""
     p, slab = case.params, case.column.slab
     depth = sum(ly.thickness for ly in slab)
+    crack, dt_ratio = from_checkpoint(run_dir, rec["id"])
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "predicted": rec["predicted"],
             "static_class": rec.get("static_class"), "slab_depth_m": p.slab_depth,
             "slab_density": sum(ly.thickness * ly.density for ly in slab) / depth, "slope_deg": p.slope_angle,
             "column_m": p.length, "cut_share": rec["recorded_cut"] / p.length, "column_ends": p.column_ends,
             "w_f": rec["w_f"], "w_f_read_back": rec.get("w_f_source") == "read back",
             "recorded_cut": rec["recorded_cut"], "runaway_cut": rec.get("runaway_cut"),
-            "slab_fracture_at": rec.get("slab_fracture_at"), "slab_crack_ratio": slab_cracked(run_dir, rec["id"])}
+            "slab_fracture_at": rec.get("slab_fracture_at"), "slab_crack_ratio": crack,
+            "substratum_share": p.substratum_depth / (p.slab_depth + p.weak_layer_thickness + p.substratum_depth),
+            "c_p_over_slab": dt_ratio, "particles": rec.get("particles"), "steps": rec.get("steps"),
+            "wall_s": rec.get("wall_s")}
 
 
 def _median(xs):
@@ -81,29 +90,41 @@ def group(rows: list[dict]) -> dict:
             "weac_static_SF": sum(r["static_class"] == "SF" for r in rows)}
 
 
+def cost(rows: list[dict]) -> dict:
+    """Where the cases' time goes that the column, not the physics of the crack, decides: the substratum's share
+    of the column and whether its P-wave speed (above the slab's) sets the time step."""
+    faster = [r["c_p_over_slab"] for r in rows if r["c_p_over_slab"] is not None and r["c_p_over_slab"] > 1.0 + 1e-9]
+    return {"cases": len(rows), "substratum_share_median": _median([r["substratum_share"] for r in rows]),
+            "substratum_share_range": [min(r["substratum_share"] for r in rows),
+                                       max(r["substratum_share"] for r in rows)] if rows else None,
+            "substratum_sets_dt": len(faster), "c_p_over_slab_median_there": _median(faster),
+            "c_p_over_slab_max": max(faster, default=None)}
+
+
 def main(argv=None) -> int:
     p = parser(__doc__, "the first six cases")
-    p.add_argument("runs", help="the field batch's runs folder (field_batch.py --runs)")
-    p.add_argument("data", help="folder of CAAML files the batch read")
+    p.add_argument("runs", nargs="+", help="field batches' runs folders (field_batch.py --runs)")
+    p.add_argument("--data", required=True, help="folder of CAAML files the batches read")
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
     recs = []
-    for path in sorted(glob.glob(os.path.join(args.runs, "*.json"))):
-        with open(path) as fh:
-            r = json.load(fh)
-        if r.get("status") == "ok" and r.get("observed") and "predicted" in r:
-            recs.append(r)
+    for run_dir in args.runs:
+        for path in sorted(glob.glob(os.path.join(run_dir, "*.json"))):
+            with open(path) as fh:
+                r = json.load(fh)
+            if r.get("status") == "ok" and r.get("observed") and "predicted" in r:
+                recs.append({**r, "run_dir": run_dir})
     recs = recs[:6] if args.quick else recs
     cases, _ = gather([os.path.join(args.data, p) for p in sorted({r["pit"] for r in recs})], calibrate=False)
     by = {(c.pit, c.test): c for c in cases}
-    rows = [describe(r, by[(r["pit"], r["test"])], args.runs) for r in recs if (r["pit"], r["test"]) in by]
+    rows = [describe(r, by[(r["pit"], r["test"])], r["run_dir"]) for r in recs if (r["pit"], r["test"]) in by]
     classes = ("END", "SF", "ARR")
-    data = {"name": "field_disagreements", "runs": os.path.basename(os.path.normpath(args.runs)),
+    data = {"name": "field_disagreements", "runs": [os.path.basename(os.path.normpath(d)) for d in args.runs],
             "data": os.path.basename(os.path.normpath(args.data)), "environment": environment("cpu"),
             "by_observed": {c: group([r for r in rows if r["observed"] == c]) for c in classes},
             "by_pair": {f"{o}->{q}": group(g) for o in classes for q in sorted({r["predicted"] for r in rows})
                         if (g := [r for r in rows if r["observed"] == o and r["predicted"] == q])},
-            "cases": rows}
+            "cost": cost(rows), "cases": rows}
     path = write_json("field_disagreements", data, out_dir(args, RESULTS, "field_disagreements"))
     print(f"{path}: {len(rows)} cases")
     return 0

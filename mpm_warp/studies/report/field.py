@@ -194,7 +194,9 @@ def _group_row(name: str, g: dict) -> list[str]:
 
 
 @section("field", "Where the model and the observers disagree", "field/results/field_disagreements.json",
-         lambda d: f"python benchmarks/field/disagreements.py RUNDIR DIR  # RUNDIR: the runs of {d['runs']}",
+         lambda d: "python benchmarks/field/disagreements.py " + " ".join(
+             "RUNDIR" + str(k + 1) for k in range(len(d["runs"]))) + " --data DIR  # " + ", ".join(
+             f"RUNDIR{k + 1}: {r}" for k, r in enumerate(d["runs"])),
          question="What do the columns the model gets wrong have in common (docs/field.md)?")
 def render_disagreements(data: dict, ctx) -> list[str]:
     heads = ["observed -> predicted", "cases", "slab depth (cm)", "slab density (kg/m^3)", "slope (deg)",
@@ -204,4 +206,15 @@ def render_disagreements(data: dict, ctx) -> list[str]:
     return (["Medians over each group of the batch's scored cases; counts where a column is a count. The slab cracked: "
              "its largest effective tensile stress reached its strength somewhere (kappa, docs/model.md §9), "
              "whether or not it broke through.", ""]
-            + table(heads, rows) + ["", env_note(data, verb="computed")])
+            + table(heads, rows) + _substratum(data.get("cost")) + ["", env_note(data, verb="computed")])
+
+
+def _substratum(c: dict | None) -> list[str]:
+    if not c or not c.get("cases"):
+        return []
+    lo, hi = c["substratum_share_range"]
+    return ["", f"- **The column's cost beside the crack:** the substratum (the profile's snow below the weak layer, "
+            f"docs/profiles.md) is {pct(c['substratum_share_median'], 0)} of the column's height (median; "
+            f"{pct(lo, 0)}-{pct(hi, 0)}), and its P-wave speed, above the slab's, sets the time step in "
+            f"{c['substratum_sets_dt']} of {c['cases']} cases (by {fx(c['c_p_over_slab_median_there'], 2)}x, median; "
+            f"up to {fx(c['c_p_over_slab_max'], 2)}x): those cases take that many more steps than their slab needs."]
