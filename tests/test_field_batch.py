@@ -8,7 +8,7 @@ import os
 import pytest
 
 from mpm_warp.cli import main
-from mpm_warp.field.batch import run_field, score_records
+from mpm_warp.field.batch import finished_records, gather, run_field, score_records
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.field.scores import baseline_majority, scores
 from mpm_warp.field.table import table_profiles
@@ -58,6 +58,9 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     first = run_field([str(table)], out, workers=1, limit=1, progress=False)
     (rec,) = first.records
     assert rec["status"] == "ok" and first.skipped == 0
+    # what the stopped batch has measured, read back without running the other case
+    cases, _ = gather([str(table)], calibrate=False)
+    assert len(cases) == 2 and finished_records(cases, out) == [rec]
     done = os.path.join(out, rec["id"] + ".json")
     stamp = os.stat(done).st_mtime_ns
     again = run_field([str(table)], out, workers=1, progress=False, protocol=FieldProtocol(threads=2))

@@ -22,7 +22,7 @@ import tempfile
 import time
 import warnings
 
-from mpm_warp.field.batch import gather, run_cases
+from mpm_warp.field.batch import FieldBatch, finished_records, gather, run_cases, score_records
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.field.scores import field_class
 from mpm_warp.studies.environment import environment, write_json
@@ -63,6 +63,9 @@ def main(argv=None) -> int:
     p.add_argument("--threads", type=int, default=FieldProtocol.threads, help="CPU threads of each case (default 1)")
     p.add_argument("--max-particles", type=int, default=FieldProtocol.max_particles, help="per-case budget")
     p.add_argument("--limit", type=int, default=None, help="run only the first N selected cases (a rate measurement)")
+    p.add_argument("--finished-only", action="store_true",
+                   help="score the selected cases whose runs in --runs have finished, and run none (a batch stopped "
+                        "early)")
     p.add_argument("--no-measured", action="store_true",
                    help="leave out the measured-density columns (a first, small sample: the stratified part only)")
     args = p.parse_args(argv)
@@ -76,17 +79,22 @@ def main(argv=None) -> int:
     runs = args.runs or tempfile.mkdtemp(prefix="mpm_warp_field_batch_")
     env = environment(args.device)
     t1 = time.perf_counter()
-    batch = run_cases(chosen, [], runs, workers=args.workers, device=args.device,
-                      protocol=FieldProtocol(max_particles=budget, threads=args.threads), progress=True)
+    if args.finished_only:
+        recs = finished_records(chosen, runs)
+        batch = FieldBatch(recs, [], score_records(recs), len(recs), runs)
+    else:
+        batch = run_cases(chosen, [], runs, workers=args.workers, device=args.device,
+                          protocol=FieldProtocol(max_particles=budget, threads=args.threads), progress=True)
     wall = time.perf_counter() - t1
     ok = [r for r in batch.records if r.get("status") == "ok"]
     data = {"name": "field_batch", "data": os.path.basename(os.path.normpath(args.data)), "environment": env,
             "selection": {"runnable": len(cases), "refused": len(refused), **counts, "seed": args.seed,
-                          "per_class": per, "max_particles": budget, "limit": args.limit},
+                          "per_class": per, "max_particles": budget, "limit": args.limit,
+                          "finished_only": args.finished_only},
             "workers": args.workers, "threads_per_case": args.threads,
             "scores": batch.scores, "batch_wall_s": wall, "setup_wall_s": t1 - t0,
             "cases_per_hour": 3600.0 * len(ok) / wall if wall > 0 and batch.skipped == 0 else None,
-            "refused_at_build": [r.line() for r in batch.refused],
+            "refused_at_build": None if args.finished_only else [r.line() for r in batch.refused],
             "resumed_cases": batch.skipped, "runs": runs,
             "cases": [{k: r.get(k) for k in ("id", "test", "observed", "predicted", "static_class", "recorded_cut",
                                              "runaway_cut", "w_f", "w_f_source", "particles", "steps", "wall_s",

@@ -37,7 +37,7 @@ from .scores import baseline_majority, field_class, scores
 from .static_rule import weac_static_class
 from .table import table_profiles
 
-__all__ = ["run_field", "run_cases", "gather", "score_records", "FieldBatch"]
+__all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "FieldBatch"]
 
 
 @dataclass
@@ -128,6 +128,13 @@ def run_case(task: dict) -> dict:
 
 def _finished(task: dict) -> dict | None:
     return io.finished_record(os.path.join(task["out_dir"], task["id"]))
+
+
+def finished_records(cases: list, out_dir: str) -> list[dict]:
+    """The records of ``cases`` (in order; :func:`run_cases`'s list) whose runs in ``out_dir`` have finished: what a
+    batch stopped early has measured, scored without running or building anything."""
+    recs = (_finished({"out_dir": out_dir, "id": _case_id(c, k)}) for k, c in enumerate(cases))
+    return [r for r in recs if r is not None]
 
 
 def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:

@@ -69,6 +69,7 @@ def _batch_command(d: dict, out: str = "") -> str:
             + (f" --workers {d['workers']}" if d.get("workers") else "")
             + (f" --threads {d['threads_per_case']}" if d.get("threads_per_case", 1) != 1 else "")
             + (f" --limit {sel['limit']}" if sel.get("limit") else "")
+            + (" --finished-only" if sel.get("finished_only") else "")
             + (f" --out {out}" if out else ""))
 
 
@@ -108,11 +109,19 @@ def render_batch(data: dict, ctx) -> list[str]:
             for name, s in (("the model (MPM, field protocol)", sc["model"]), ("majority class", sc["majority"]),
                             ("weac's static rule", sc["weac_static"]))]
     built = data.get("refused_at_build") or []
-    out = [f"Cases: {count(sc['cases'])} scored ({count(sc['failed'])} failed), drawn from the "
-           f"{count(sel['runnable'])} records set up before calibration: {sel.get('measured', 0)} with measured slab "
-           f"densities, and {sel.get('END', 0)} END, {sel.get('SF', 0)} SF, {sel.get('ARR', 0)} ARR by class (seed "
-           f"{sel['seed']}); {count(len(built))} of those refused when built (the per-case budget, or the "
-           "calibration), in the JSON's `refused_at_build`.", ""]
+    drawn = (f"drawn from the {count(sel['runnable'])} records set up before calibration: {sel.get('measured', 0)} "
+             f"with measured slab densities, and {sel.get('END', 0)} END, {sel.get('SF', 0)} SF, {sel.get('ARR', 0)} "
+             f"ARR by class (seed {sel['seed']})")
+    if sel.get("finished_only"):
+        n_sel = sel.get("measured", 0) + sel.get("END", 0) + sel.get("SF", 0) + sel.get("ARR", 0)
+        out = [f"Cases: {count(sc['cases'])} scored ({count(sc['failed'])} failed) of the {count(n_sel)} selected, "
+               f"{drawn}. **A batch stopped early:** these are the cases whose runs had finished, scored with "
+               "`--finished-only`; the selection runs its classes interleaved, so the finished ones are spread "
+               "over the three classes, but the rest are not run yet.", ""]
+    else:
+        out = [f"Cases: {count(sc['cases'])} scored ({count(sc['failed'])} failed), {drawn}; {count(len(built))} of "
+               "those refused when built (the per-case budget, or the calibration), in the JSON's "
+               "`refused_at_build`.", ""]
     out += table(["predictor", "cases", "balanced accuracy", "recall END", "recall SF", "recall ARR"], rows)
     conf = sc["model"]["confusion"]
     out += ["", "The model's confusion matrix (rows: observed; columns: predicted):", ""]
