@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from statistics import median
+
 from .core import section
 from .fmt import count, env_note, fx, pct, secs, spct, table
 
@@ -83,11 +85,6 @@ def _threads(n: int) -> str:
     return "one thread" if n == 1 else f"{n} threads"
 
 
-def _med(xs: list) -> float:
-    xs = sorted(xs)
-    return xs[len(xs) // 2] if len(xs) % 2 else 0.5 * (xs[len(xs) // 2 - 1] + xs[len(xs) // 2])
-
-
 def _workers(n) -> str:
     return "one worker per core" if not n else f"{n} worker{'s' if n != 1 else ''}"
 
@@ -144,10 +141,10 @@ def render_batch(data: dict, ctx) -> list[str]:
                "here; each case's wall time is its own run's, on this shared machine).")]
     ran = [c for c in data.get("cases", []) if c.get("status") == "ok" and c.get("particles") and c.get("steps")]
     if ran:
-        work = _med([c["particles"] * c["steps"] for c in ran])
-        ns = _med([c["wall_s"] / (c["particles"] * c["steps"]) * 1e9 for c in ran])
-        out += ["", f"- **Cost:** medians over the cases: {count(_med([c['particles'] for c in ran]))} particles, "
-                f"{count(_med([c['steps'] for c in ran]))} steps, {fx(work / 1e9, 2)} G particle-steps (particles "
+        work = median([c["particles"] * c["steps"] for c in ran])
+        ns = median([c["wall_s"] / (c["particles"] * c["steps"]) * 1e9 for c in ran])
+        out += ["", f"- **Cost:** medians over the cases: {count(median([c['particles'] for c in ran]))} particles, "
+                f"{count(median([c['steps'] for c in ran]))} steps, {fx(work / 1e9, 2)} G particle-steps (particles "
                 f"times steps), {fx(ns, 0)} ns of wall time a particle-step. {CASE_BUDGET_S:g} s at that rate is "
                 f"{fx(CASE_BUDGET_S / ns, 2)} G particle-steps: the median case's work is "
                 f"{fx(work * ns / 1e9 / CASE_BUDGET_S, 1)}x that."]
@@ -185,7 +182,7 @@ def render_rate(data: dict, ctx) -> list[str]:
              if c.get("status") == "ok" and c["id"] in there]
     if pairs:
         r = sorted(a / b for a, b in pairs)
-        med = _med(r)
+        med = median(r)
         out[-1:-1] = [f"- **Against two workers of one thread:** the same {len(pairs)} cases took "
                       f"{', '.join(secs(a) for a, _ in pairs)} each in the measured-density batch (2 workers of one "
                       f"thread, {fx(other.get('cases_per_hour'), 0)} cases an hour over its "
