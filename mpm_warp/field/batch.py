@@ -36,6 +36,7 @@ from .protocol import FieldProtocol, decided, protocol_params
 from .scores import baseline_majority, field_class, scores
 from .static_rule import weac_static_class
 from .table import table_profiles
+from .uncertainty import balanced_accuracy_intervals
 
 __all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "FieldBatch"]
 
@@ -271,10 +272,11 @@ def score_records(recs: list) -> dict:
     """Scores of the model and of the baselines on the cases that ran (``status`` ok, an observed class)."""
     ok = [r for r in recs if r.get("status") == "ok" and r.get("observed")]
     obs = [r["observed"] for r in ok]
+    pred = {"model": [r["predicted"] for r in ok], "majority": baseline_majority(obs),
+            "weac_static": [r.get("static_class") or "none" for r in ok]}
     return {"cases": len(ok), "failed": sum(r.get("status") != "ok" for r in recs),
-            "model": scores(obs, [r["predicted"] for r in ok]),
-            "majority": scores(obs, baseline_majority(obs)),
-            "weac_static": scores(obs, [r.get("static_class") or "none" for r in ok]),
+            **{name: scores(obs, p) for name, p in pred.items()},
+            "uncertainty": balanced_accuracy_intervals(obs, pred, reference="model"),
             "wall_s": {"median": _median([r["wall_s"] for r in ok]), "total": sum(r["wall_s"] for r in ok)}}
 
 

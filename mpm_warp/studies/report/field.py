@@ -75,6 +75,28 @@ def _batch_command(d: dict, out: str = "") -> str:
             + (f" --out {out}" if out else ""))
 
 
+def _interval(iv) -> str:
+    return "" if not iv else f" [{iv[0]:.2f}, {iv[1]:.2f}]"
+
+
+def _signed(v: float) -> str:
+    return "0.00" if abs(v) < 0.005 else f"{v:+.2f}"
+
+
+def _differences(unc: dict) -> str:
+    """The model less each baseline, with its bootstrap interval (mpm_warp.field.uncertainty)."""
+    diffs = unc.get("differences") or {}
+    if not diffs:
+        return ""
+    words = {"majority": "the majority class", "weac_static": "weac's static rule"}
+    parts = [f"{words.get(k, k)} {_signed(v['value'])} [{_signed(v['interval'][0])}, {_signed(v['interval'][1])}], "
+             "higher in "
+             f"{fx(100 * v['share_above'], 0)} % of the resamples" for k, v in diffs.items()]
+    return (f" The model less each baseline, on the same cases resampled within each observed class "
+            f"({count(unc['resamples'])} resamples, {fx(100 * unc['level'], 0)} % intervals): " + "; ".join(parts)
+            + ". An interval that holds 0 does not tell the model from that baseline.")
+
+
 def _verdict(sc: dict, m, best: float) -> str:
     if sc["cases"] < 150:
         return "open"
@@ -102,9 +124,11 @@ def _command_to(out: str):
                   "weac's static rule?")
 def render_batch(data: dict, ctx) -> list[str]:
     sc, sel = data["scores"], data["selection"]
-    rows = [[name, count(s["n"]), _ba(s), _recall(s, "END"), _recall(s, "SF"), _recall(s, "ARR")]
-            for name, s in (("the model (MPM, field protocol)", sc["model"]), ("majority class", sc["majority"]),
-                            ("weac's static rule", sc["weac_static"]))]
+    unc = sc.get("uncertainty") or {}
+    names = (("model", "the model (MPM, field protocol)"), ("majority", "majority class"),
+             ("weac_static", "weac's static rule"))
+    rows = [[label, count(sc[key]["n"]), _ba(sc[key]) + _interval((unc.get("intervals") or {}).get(key)),
+             _recall(sc[key], "END"), _recall(sc[key], "SF"), _recall(sc[key], "ARR")] for key, label in names]
     built = data.get("refused_at_build") or []
     drawn = (f"drawn from the {count(sel['runnable'])} records set up before calibration: {sel.get('measured', 0)} "
              f"with measured slab densities, and {sel.get('END', 0)} END, {sel.get('SF', 0)} SF, {sel.get('ARR', 0)} "
@@ -119,7 +143,8 @@ def render_batch(data: dict, ctx) -> list[str]:
         out = [f"Cases: {count(sc['cases'])} scored ({count(sc['failed'])} failed), {drawn}; {count(len(built))} of "
                "those refused when built (the per-case budget, or the calibration), in the JSON's "
                "`refused_at_build`.", ""]
-    out += table(["predictor", "cases", "balanced accuracy", "recall END", "recall SF", "recall ARR"], rows)
+    level = f" ({fx(100 * unc['level'], 0)} % interval)" if unc.get("intervals") else ""
+    out += table(["predictor", "cases", f"balanced accuracy{level}", "recall END", "recall SF", "recall ARR"], rows)
     conf = sc["model"]["confusion"]
     out += ["", "The model's confusion matrix (rows: observed; columns: predicted):", ""]
     out += table(["observed", *conf["columns"]], [[r, *[count(n) for n in c]] for r, c in zip(conf["rows"],
@@ -130,7 +155,7 @@ def render_batch(data: dict, ctx) -> list[str]:
     out += ["", f"**Check:** the model's balanced accuracy above both baselines': {_ba(sc['model'])} against "
             f"{best:.2f}, **{_verdict(sc, m, best)}**"
             + (" (too few cases to tell: at least 50 per class are needed; a balanced accuracy is over the observed "
-               "classes present)" if sc["cases"] < 150 else "") + ".", "",
+               "classes present)" if sc["cases"] < 150 else "") + "." + _differences(unc), "",
             f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time: {secs(med)}, "
             f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** (particle budget "
             f"{count(sel['max_particles'])}, {_threads(data.get('threads_per_case', 1))} per case, "
