@@ -1,0 +1,153 @@
+"""Why did the slab not break? A field run's slab stress against its strength and against weac's static beam.
+
+For each selected finished case of a field batch (default: every observed SF the model did not call SF), the
+case runs again from its own scenario (the one in its checkpoint: the field protocol, the same stop) with the
+particles' stress stored at every frame. Per frame: the blade, the damage front, and each slab layer's
+largest in-plane principal stress over its tensile strength (the run's own, Sigrist 2006 from density).
+The crack's onset is the blade's position at the first frame the damage front leads it by two cells.
+
+Beside it, weac's static solution of the same column at the recorded cut and at the onset: the slab's
+largest stress over strength over the cut (the cantilever's bending) and at the crack tip (where weac's
+beam puts the weak layer's reaction), as the static rule of the batch reads it (docs/field.md). Each slab
+layer's thickness in grid cells says where a thin layer is resolved by one or two cells only. Nothing here
+changes the model. Writes ``benchmarks/field/results/field_slab_stress.json``.
+
+Usage: ``python benchmarks/field/slab_stress.py RUNDIR [RUNDIR ...] [--cases ID ...]``; ``--quick``: the first
+selected case, to a temporary folder. Minutes of CPU a case.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import glob
+import json
+import os
+import sys
+import tempfile
+import time
+import warnings
+
+import h5py
+import numpy as np
+
+from mpm_warp.field.protocol import decided
+from mpm_warp.io.checkpoint import read_checkpoint_meta
+from mpm_warp.loader import resolved_scenario
+from mpm_warp.runner import run
+from mpm_warp.scenes.pst.static import static_column
+from mpm_warp.scenes.weac_reference import slab_stress
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+
+#: the crack has started once the damage front leads the blade by this many grid cells
+ONSET_CELLS = 2.0
+
+
+def principal_2d(stress: np.ndarray) -> np.ndarray:
+    """Largest in-plane principal stress (Pa) of Cauchy stresses ``(n, 3, 3)`` (plane strain: the in-plane block)."""
+    a, b, c = stress[:, 0, 0], stress[:, 1, 1], stress[:, 0, 1]
+    return 0.5 * (a + b) + np.sqrt(0.25 * (a - b) ** 2 + c * c)
+
+
+def run_series(scenario, path: str, threads: int) -> dict:
+    """Run ``scenario`` with stress frames into ``path``; per frame the blade, the front and each slab layer's
+    peak ratio (top to bottom)."""
+    sc = dataclasses.replace(scenario, output=dataclasses.replace(scenario.output, fields=("x", "stress")))
+    t0 = time.perf_counter()
+    res = run(sc, path, device="cpu", overwrite=True, n_threads=threads, callback=lambda sim, frame: not decided(sim))
+    wall = time.perf_counter() - t0
+    slabs = sorted((n for n in sc.materials if n.startswith("slab")), key=lambda n: int(n.split("_")[-1]))
+    with h5py.File(path, "r") as f:
+        groups = [g["name"] if isinstance(g, dict) else g for g in json.loads(f.attrs["groups"])]
+        member = f["static/group"][:]
+        ratio = np.empty((f["time"].shape[0], len(slabs)))
+        for k in range(ratio.shape[0]):
+            s1 = principal_2d(f["particles/stress"][k])
+            for j, name in enumerate(slabs):
+                ratio[k, j] = s1[member == groups.index(name)].max() / sc.materials[name].tensile_strength
+        series = {"t": f["time"][:].tolist(), "saw": f["scalars/saw"][:].tolist(),
+                  "front": f["scalars/front"][:].tolist(), "ratio": ratio.tolist()}
+    o = res.scene_result.get("outcome", {})
+    return {"series": series, "layers": slabs, "predicted": o.get("class"), "wall_s": wall}
+
+
+def onset_cut(series: dict, dx: float) -> float | None:
+    """The blade's position (m) at the first frame the damage front leads it by :data:`ONSET_CELLS` cells."""
+    for saw, front in zip(series["saw"], series["front"], strict=True):
+        if front - saw >= ONSET_CELLS * dx:
+            return float(saw)
+    return None
+
+
+def weac_ratios(params, cut: float) -> dict:
+    """weac's static slab stress over strength at ``cut`` (m): over the cut, and at the crack tip."""
+    strengths = [ly.strength for ly in params.slab_stack()]
+    st = slab_stress(static_column(params), cut, strengths, dx=0.005, dz=0.002)
+    over = st["ratio"][:, st["cracked"]]
+    tip = st["ratio"][:, np.isclose(st["x"], cut, rtol=0.0, atol=1e-9)]
+    return {"cut": cut, "over_cut": float(over.max()) if over.size else None, "tip": float(tip.max()),
+            "peak_layer": int(st["peak_ratio_layer"])}
+
+
+def mpm_ratio_to(series: dict, cut: float) -> float | None:
+    """The run's largest slab stress over strength (any layer) while the blade had cut at most ``cut`` (m)."""
+    r = [max(row) for saw, row in zip(series["saw"], series["ratio"], strict=True) if saw <= cut + 1e-9]
+    return max(r) if r else None
+
+
+def case_row(rec: dict, run_dir: str, tmp: str, threads: int) -> dict:
+    ck = os.path.join(run_dir, rec["id"] + ".ckpt.h5")
+    sc = resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck)
+    p = sc.scene
+    out = run_series(sc, os.path.join(tmp, rec["id"] + ".h5"), threads)
+    s, onset = out["series"], onset_cut(out["series"], p.dx)
+    layers = [{"thickness_m": ly.thickness, "density": ly.density, "cells": ly.thickness / p.dx,
+               "tensile_strength": ly.strength, "peak_ratio": max(row[j] for row in s["ratio"])}
+              for j, ly in enumerate(p.slab_stack())]
+    return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "predicted_batch": rec["predicted"],
+            "predicted": out["predicted"], "slope_deg": p.slope_angle, "dx": p.dx, "recorded_cut": rec["recorded_cut"],
+            "onset_cut": onset, "runaway_cut": rec.get("runaway_cut"), "layers": layers,
+            "mpm_peak_ratio": max(max(row) for row in s["ratio"]),
+            "mpm_ratio_to_recorded_cut": mpm_ratio_to(s, rec["recorded_cut"]),
+            "mpm_ratio_to_onset": mpm_ratio_to(s, onset) if onset is not None else None,
+            "weac_at_recorded_cut": weac_ratios(p, rec["recorded_cut"]),
+            "weac_at_onset": weac_ratios(p, onset) if onset else None,
+            "wall_s": out["wall_s"], "series": s}
+
+
+def main(argv=None) -> int:
+    p = parser(__doc__, "the first selected case")
+    p.add_argument("runs", nargs="+", help="field batches' runs folders (field_batch.py --runs)")
+    p.add_argument("--cases", nargs="+", metavar="ID", help="case ids (default: observed SF, not predicted SF)")
+    p.add_argument("--threads", type=int, default=1, help="CPU threads of each run (default 1)")
+    args = p.parse_args(argv)
+    warnings.filterwarnings("ignore")
+    recs = []
+    for run_dir in args.runs:
+        for path in sorted(glob.glob(os.path.join(run_dir, "*.json"))):
+            with open(path) as fh:
+                r = json.load(fh)
+            if r.get("status") != "ok" or "predicted" not in r:
+                continue
+            if (r["id"] in args.cases) if args.cases else (r.get("observed") == "SF" and r["predicted"] != "SF"):
+                recs.append((r, run_dir))
+    recs = recs[:1] if args.quick else recs
+    dest = out_dir(args, RESULTS, "field_slab_stress")
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="mpm_warp_slab_stress_") as tmp:
+        for r, run_dir in recs:
+            rows.append(case_row(r, run_dir, tmp, args.threads))
+            print(f"{r['test']}: MPM peak {rows[-1]['mpm_peak_ratio']:.2f} of strength, weac at the recorded cut "
+                  f"{rows[-1]['weac_at_recorded_cut']['over_cut']} over the cut, "
+                  f"{rows[-1]['weac_at_recorded_cut']['tip']:.2f} at the tip", flush=True)
+    data = {"name": "field_slab_stress", "runs": [os.path.basename(os.path.normpath(d)) for d in args.runs],
+            "onset_cells": ONSET_CELLS, "environment": environment("cpu"), "cases": rows}
+    path = write_json("field_slab_stress", data, dest)
+    print(f"{path}: {len(rows)} cases")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
