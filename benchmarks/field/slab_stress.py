@@ -9,8 +9,9 @@ The crack's onset is the blade's position at the first frame the damage front le
 Beside it, weac's static solution of the same column at the recorded cut and at the onset: the slab's
 largest stress over strength over the cut (the cantilever's bending) and at the crack tip (where weac's
 beam puts the weak layer's reaction), as the static rule of the batch reads it (docs/field.md). Each slab
-layer's thickness in grid cells says where a thin layer is resolved by one or two cells only. Nothing here
-changes the model. Writes ``benchmarks/field/results/field_slab_stress.json``.
+layer's thickness in grid cells says where a thin layer is resolved by one or two cells only. The control
+is a homogeneous soft slab sawn to below its critical cut, where weac's beam is exact. Nothing here changes
+the model. Writes ``benchmarks/field/results/field_slab_stress.json``.
 
 Usage: ``python benchmarks/field/slab_stress.py RUNDIR [RUNDIR ...] [--cases ID ...]``; ``--quick``: the first
 selected case, to a temporary folder. Minutes of CPU a case.
@@ -30,11 +31,15 @@ import warnings
 import h5py
 import numpy as np
 
+from mpm_warp.config import TimeControl
 from mpm_warp.field.protocol import decided
 from mpm_warp.io.checkpoint import read_checkpoint_meta
 from mpm_warp.loader import resolved_scenario
 from mpm_warp.runner import run
+from mpm_warp.scenes.pst import PSTParams, build
+from mpm_warp.scenes.pst.saw import Saw
 from mpm_warp.scenes.pst.static import static_column
+from mpm_warp.scenes.snowpack import SnowLayer
 from mpm_warp.scenes.weac_reference import slab_stress
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -43,6 +48,11 @@ RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 #: the crack has started once the damage front leads the blade by this many grid cells
 ONSET_CELLS = 2.0
+
+#: the control: a homogeneous soft slab (20 cm of 120 kg/m^3, E and strength from density) on flat ground, sawn
+#: at 1 m/s from the upslope end to 0.36 m (weac's critical cut 0.40 m): the run's slab stress against weac's
+#: beam where the beam is exact, before the crack starts
+CONTROL_CUTS = (0.1, 0.15, 0.2, 0.25, 0.3)
 
 
 def principal_2d(stress: np.ndarray) -> np.ndarray:
@@ -71,6 +81,20 @@ def run_series(scenario, path: str, threads: int) -> dict:
                   "front": f["scalars/front"][:].tolist(), "ratio": ratio.tolist()}
     o = res.scene_result.get("outcome", {})
     return {"series": series, "layers": slabs, "predicted": o.get("class"), "wall_s": wall}
+
+
+def control(tmp: str, threads: int) -> dict:
+    """The homogeneous control (:data:`CONTROL_CUTS`): per cut, the run's slab stress over strength while the blade
+    had cut at most that much, and weac's over the cut there."""
+    p = PSTParams(length=2.0, slab_layers=(SnowLayer(0.2, 120.0),), slab_fracture=True,
+                  saw=Saw(cut_length=0.36, speed=1.0))
+    p = dataclasses.replace(p, weak_layer=dataclasses.replace(p.weak_layer, tau_p=700.0, h_c=0.006))
+    sc = build(p.validate("scene"), TimeControl(end=p.saw_start + 0.36, frame_interval=0.005), name="control")
+    out = run_series(sc, os.path.join(tmp, "control.h5"), threads)
+    rows = [{"cut": cut, "run": mpm_ratio_to(out["series"], cut), "weac": weac_ratios(sc.scene, cut)["over_cut"]}
+            for cut in CONTROL_CUTS]
+    return {"what": "20 cm of 120 kg/m^3 on flat ground, 2 m column, sawn to 0.36 m", "dx": p.dx,
+            "rows": rows, "wall_s": out["wall_s"]}
 
 
 def onset_cut(series: dict, dx: float) -> float | None:
@@ -139,6 +163,10 @@ def main(argv=None) -> int:
     data = {"name": "field_slab_stress", "runs": [os.path.basename(os.path.normpath(d)) for d in args.runs],
             "onset_cells": ONSET_CELLS, "selected": len(recs), "environment": environment("cpu"), "cases": []}
     with tempfile.TemporaryDirectory(prefix="mpm_warp_slab_stress_") as tmp:
+        data["control"] = control(tmp, args.threads)
+        print("control: " + ", ".join(f"{r['cut']:g} m: run {r['run']:.3f}, weac {r['weac']:.3f}"
+                                      for r in data["control"]["rows"]), flush=True)
+        path = write_json("field_slab_stress", data, dest)
         for r, run_dir in recs:
             row = case_row(r, run_dir, tmp, args.threads)
             data["cases"].append(row)
