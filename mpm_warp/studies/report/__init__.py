@@ -30,7 +30,7 @@ import argparse
 import os
 import sys
 
-from . import convergence, field, main_job, perf, robustness, scaling, snow_runs, snow_studies, snowpack  # noqa: F401
+from . import convergence, field, field_slab, main_job, perf, robustness, scaling, snow_runs, snow_studies, snowpack  # noqa: F401
 from .core import DOC, SECTIONS, Context, document, pending, section
 from .readme import block, headlines, with_block
 
