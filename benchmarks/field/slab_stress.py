@@ -68,7 +68,8 @@ def run_series(scenario, path: str, threads: int) -> dict:
     t0 = time.perf_counter()
     res = run(sc, path, device="cpu", overwrite=True, n_threads=threads, callback=lambda sim, frame: not decided(sim))
     wall = time.perf_counter() - t0
-    slabs = sorted((n for n in sc.materials if n.startswith("slab")), key=lambda n: int(n.split("_")[-1]))
+    slabs = sorted((n for n in sc.materials if n.startswith("slab")),     # "slab", or "slab_1" (top) to "slab_N"
+                   key=lambda n: int(n.rsplit("_", 1)[-1]) if "_" in n else 0)
     with h5py.File(path, "r") as f:
         groups = [g["name"] if isinstance(g, dict) else g for g in json.loads(f.attrs["groups"])]
         member = f["static/group"][:]
