@@ -95,6 +95,7 @@ def control(tmp: str, threads: int) -> dict:
     rows = [{"cut": cut, "run": mpm_ratio_to(out["series"], cut), "weac": weac_ratios(sc.scene, cut)["over_cut"]}
             for cut in CONTROL_CUTS]
     return {"what": "20 cm of 120 kg/m^3 on flat ground, 2 m column, sawn to 0.36 m", "dx": p.dx,
+            "slab_depth_m": p.slab_depth,
             "rows": rows, "wall_s": out["wall_s"]}
 
 
@@ -132,7 +133,8 @@ def case_row(rec: dict, run_dir: str, tmp: str, threads: int) -> dict:
                "tensile_strength": ly.strength, "peak_ratio": max(row[j] for row in s["ratio"])}
               for j, ly in enumerate(p.slab_stack())]
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "predicted_batch": rec["predicted"],
-            "predicted": out["predicted"], "slope_deg": p.slope_angle, "dx": p.dx, "recorded_cut": rec["recorded_cut"],
+            "predicted": out["predicted"], "slope_deg": p.slope_angle, "dx": p.dx, "slab_depth_m": p.slab_depth,
+            "recorded_cut": rec["recorded_cut"],
             "onset_cut": onset, "runaway_cut": rec.get("runaway_cut"), "layers": layers,
             "mpm_peak_ratio": max(max(row) for row in s["ratio"]),
             "mpm_ratio_to_recorded_cut": mpm_ratio_to(s, rec["recorded_cut"]),
