@@ -1,20 +1,23 @@
 """Why did the slab not break? A field run's slab stress against its strength and against weac's static beam.
 
-For each selected finished case of a field batch (default: every observed SF the model called END), the
-case runs again from its own scenario (the one in its checkpoint: the field protocol, the same stop) with the
-particles' stress stored at every frame. Per frame: the blade, the damage front, and each slab layer's
-largest in-plane principal stress over its tensile strength (the run's own, Sigrist 2006 from density).
-The crack's onset is the blade's position at the first frame the damage front leads it by two cells.
+For each selected finished case of a field batch (default: every observed SF the model called END; or any
+observed and predicted class, a seeded sample of them, or given cases), the case runs again from its own
+scenario (the one in its checkpoint: the field protocol, the same stop) with the particles' stress stored
+at every frame. Per frame: the blade, the damage front, and each slab layer's largest in-plane principal
+stress over its tensile strength (the run's own, Sigrist 2006 from density). The crack's onset is the
+blade's position at the first frame the damage front leads it by two cells.
 
 Beside it, weac's static solution of the same column at the recorded cut and at the onset: the slab's
 largest stress over strength over the cut (the cantilever's bending) and at the crack tip (where weac's
 beam puts the weak layer's reaction), as the static rule of the batch reads it (docs/field.md). Each slab
 layer's thickness in grid cells says where a thin layer is resolved by one or two cells only. The control
-is a homogeneous soft slab sawn to below its critical cut, where weac's beam is exact. Nothing here changes
-the model. Writes ``benchmarks/field/results/field_slab_stress.json``.
+is a homogeneous soft slab sawn to below its critical cut: there a beam's bending holds once the cut is as
+long as the slab is deep. Nothing here changes the model. Writes
+``benchmarks/field/results/field_slab_stress.json``.
 
-Usage: ``python benchmarks/field/slab_stress.py RUNDIR [RUNDIR ...] [--cases ID ...]``; ``--quick``: the first
-selected case, to a temporary folder. Minutes of CPU a case.
+Usage: ``python benchmarks/field/slab_stress.py RUNDIR [RUNDIR ...] [--observed SF --predicted END]
+[--sample N --seed 0] [--cases ID ...] [--no-control]``; ``--quick``: the first selected case, to a temporary
+folder. Minutes of CPU a case.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import dataclasses
 import glob
 import json
 import os
+import random
 import sys
 import tempfile
 import time
@@ -147,7 +151,12 @@ def case_row(rec: dict, run_dir: str, tmp: str, threads: int) -> dict:
 def main(argv=None) -> int:
     p = parser(__doc__, "the first selected case")
     p.add_argument("runs", nargs="+", help="field batches' runs folders (field_batch.py --runs)")
-    p.add_argument("--cases", nargs="+", metavar="ID", help="case ids (default: observed SF, predicted END)")
+    p.add_argument("--cases", nargs="+", metavar="ID", help="case ids (instead of --observed and --predicted)")
+    p.add_argument("--observed", default="SF", help="the observed class of the cases (default SF)")
+    p.add_argument("--predicted", default="END", help="the predicted class of the cases (default END)")
+    p.add_argument("--sample", type=int, help="a seeded sample of this many of the cases (default: all)")
+    p.add_argument("--seed", type=int, default=0, help="seed of --sample (default 0)")
+    p.add_argument("--no-control", action="store_true", help="leave out the homogeneous control")
     p.add_argument("--threads", type=int, default=1, help="CPU threads of each run (default 1)")
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
@@ -158,18 +167,24 @@ def main(argv=None) -> int:
                 r = json.load(fh)
             if r.get("status") != "ok" or "predicted" not in r:
                 continue
-            if (r["id"] in args.cases) if args.cases else (r.get("observed") == "SF" and r["predicted"] == "END"):
+            if (r["id"] in args.cases) if args.cases else (r.get("observed") == args.observed
+                                                           and r["predicted"] == args.predicted):
                 recs.append((r, run_dir))
+    if args.sample is not None and args.sample < len(recs):
+        recs = random.Random(args.seed).sample(sorted(recs, key=lambda rd: rd[0]["id"]), args.sample)
     recs = recs[:1] if args.quick else recs
     dest = out_dir(args, RESULTS, "field_slab_stress")
     recs.sort(key=lambda rd: rd[0].get("wall_s") or 0.0)        # the cheapest first: a run stopped early keeps them
     data = {"name": "field_slab_stress", "runs": [os.path.basename(os.path.normpath(d)) for d in args.runs],
-            "onset_cells": ONSET_CELLS, "selected": len(recs), "environment": environment("cpu"), "cases": []}
+            "onset_cells": ONSET_CELLS, "selection": {"cases": args.cases} if args.cases else {
+                "observed": args.observed, "predicted": args.predicted, "sample": args.sample, "seed": args.seed},
+            "selected": len(recs), "environment": environment("cpu"), "cases": []}
     with tempfile.TemporaryDirectory(prefix="mpm_warp_slab_stress_") as tmp:
-        data["control"] = control(tmp, args.threads)
-        print("control: " + ", ".join(f"{r['cut']:g} m: run {r['run']:.3f}, weac {r['weac']:.3f}"
-                                      for r in data["control"]["rows"]), flush=True)
-        path = write_json("field_slab_stress", data, dest)
+        if not args.no_control:
+            data["control"] = control(tmp, args.threads)
+            print("control: " + ", ".join(f"{r['cut']:g} m: run {r['run']:.3f}, weac {r['weac']:.3f}"
+                                          for r in data["control"]["rows"]), flush=True)
+            path = write_json("field_slab_stress", data, dest)
         for r, run_dir in recs:
             row = case_row(r, run_dir, tmp, args.threads)
             data["cases"].append(row)
