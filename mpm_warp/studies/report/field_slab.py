@@ -27,6 +27,25 @@ def _off(c: dict) -> float | None:
     return c["mpm_ratio_to_onset"] / w["over_cut"] - 1.0
 
 
+#: a layer resolved by fewer grid cells than this is named beside a failing comparison
+THIN_CELLS = 2.0
+
+
+def _thin(cases: list) -> str:
+    """The failing comparisons' slab layers resolved by fewer than :data:`THIN_CELLS` grid cells."""
+    notes = []
+    for c in cases:
+        off = _off(c)
+        if off is None or abs(off) <= AGREE:
+            continue
+        thin = [ly for ly in c["layers"] if ly["cells"] < THIN_CELLS]
+        notes.append(f"`{c['test']}`: " + ("; ".join(
+            f"its {fx(ly['thickness_m'], 1, 100)} cm layer of {fx(ly['density'], 0)} kg/m^3 has "
+            f"{fx(ly['cells'], 1)} cells" for ly in thin) if thin else "no slab layer under "
+            f"{fx(THIN_CELLS, 0)} cells"))
+    return "; where the run and weac part: " + "; ".join(notes) if notes else ""
+
+
 def _selected(data: dict) -> str:
     sel = data.get("selection") or {"observed": "SF", "predicted": "END"}
     if sel.get("cases"):
@@ -92,7 +111,8 @@ def render_slab_stress(data: dict, ctx) -> list[str]:
         out += ["", f"**Check:** on the field columns whose crack started at a cut at least as long as the slab "
                 f"is deep, the run's slab stress up to the onset within {fx(100 * AGREE, 0)} % of weac's over the "
                 f"cut at the onset, as on the control: {within} of {len(offs)} cases, "
-                f"**{'pass' if within == len(offs) else 'FAIL'}** ({', '.join(spct(o) for o in offs)})."]
+                f"**{'pass' if within == len(offs) else 'FAIL'}** ({', '.join(spct(o) for o in offs)})"
+                + _thin(cases) + "."]
     return out + ["", env_note(data)]
 
 
