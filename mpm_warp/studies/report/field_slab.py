@@ -56,14 +56,15 @@ def _selected(data: dict) -> str:
     return what + (f", a sample of {sel['sample']} drawn with seed {sel['seed']}" if sel.get("sample") else "")
 
 
-def _command(d: dict) -> str:
+def _command(d: dict, out: str = "") -> str:
     sel = d.get("selection") or {}
     opts = "" if not sel or sel.get("cases") else (
         f" --observed {sel['observed']} --predicted {sel['predicted']}"
         + (f" --sample {sel['sample']} --seed {sel['seed']}" if sel.get("sample") else ""))
-    return ("python benchmarks/field/slab_stress.py " + " ".join("RUNDIR" + str(k + 1) for k in range(len(d["runs"])))
-            + opts + ("" if d.get("control") else " --no-control") + "  # " + ", ".join(
-                f"RUNDIR{k + 1}: {r}" for k, r in enumerate(d["runs"])))
+    dirs = " ".join("RUNDIR" + str(k + 1) for k in range(len(d["runs"])))
+    tail = ("" if d.get("control") else " --no-control") + (f" --out {out}" if out else "")
+    return (f"python benchmarks/field/slab_stress.py {dirs}{opts}{tail}  # "
+            + ", ".join(f"RUNDIR{k + 1}: {r}" for k, r in enumerate(d["runs"])))
 
 
 @section("field", "Why the slab did not break", "field/results/field_slab_stress.json",
@@ -93,7 +94,10 @@ def render_slab_stress(data: dict, ctx) -> list[str]:
            f"than the onset, where the damage front first led the blade by {fx(data['onset_cells'], 0)} cells. "
            "weac: its static beam at the same cut, largest over the cut (the cantilever's bending) and at the "
            "crack tip (where the beam takes the weak layer's reaction); its tip value at the recorded cut is what "
-           "the batch's static rule reads. A layer's cells: its thickness over the grid spacing.", ""]
+           "the batch's static rule reads. A layer's cells: its thickness over the grid spacing. The run's values "
+           "are the largest over every slab particle, wherever it sits (the top surface in bending, the row next "
+           "to the weak layer, a thin layer): where they stand far above weac's beam at the same cut, they are "
+           "not the cantilever's bending.", ""]
     out += table(heads, rows)
     ctl = data.get("control")
     if ctl:
@@ -122,7 +126,7 @@ SF_SOURCE = "field/results/field_slab_stress.json"
 
 
 @section("field", "The slab's stress where the observer saw END", "field/results/end/field_slab_stress.json",
-         lambda d: _command(d) + " --out benchmarks/field/results/end",
+         lambda d: _command(d, "benchmarks/field/results/end"),
          question="Beside the SF records: how close does the run's slab come to its strength in END records the "
                   "model also called END? (A slab stress that tells SF from END would come closer in SF records.)")
 def render_end(data: dict, ctx) -> list[str]:
