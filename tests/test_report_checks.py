@@ -95,3 +95,12 @@ def test_a_critical_cut_change_inside_its_brackets_is_not_called_converged():
     assert chg == "-5.4 %, 0.0 % (brackets overlap: not resolved)"       # adjacent brackets resolve -5.4 %
     assert errs == ["5.6 %", "0.0 %: not resolved (brackets overlap)", "reference (bracket +/-2.8 %)"]
     assert times[0].startswith("1,837 s") and times[1] == "not resolved: the finest bracket is +/-2.8 %"
+
+
+def test_the_slab_stress_peak_reads_as_where_and_which_stress():
+    from mpm_warp.studies.report.field_slab import _where
+
+    # the far end's slab base pulled normal to the bed, then the top surface in bending
+    assert _where([0.989, 0.341, 2242.9, 13690.1, 1858.7]) == "0.99 m, 34.1 cm deep; normal to the bed (13.7 kPa)"
+    assert _where([0.45, 0.002, 3464.0, -6.0, 8.0]) == "0.45 m, 0.2 cm deep; along the bed (3.5 kPa)"
+    assert _where(None) == "-"

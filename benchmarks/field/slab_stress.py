@@ -66,8 +66,10 @@ def principal_2d(stress: np.ndarray) -> np.ndarray:
 
 
 def run_series(scenario, path: str, threads: int) -> dict:
-    """Run ``scenario`` with stress frames into ``path``; per frame the blade, the front and each slab layer's
-    peak ratio (top to bottom)."""
+    """Run ``scenario`` with stress frames into ``path``; per frame the blade, the front, each slab layer's peak
+    ratio (top to bottom) and where the slab's largest ratio sits: ``peak_at`` = [x0 (m along the column, at
+    the start), depth below the slab's surface (m, at the start), sigma_xx (along the bed), sigma_yy (normal to
+    it), sigma_xy (Pa)]."""
     sc = dataclasses.replace(scenario, output=dataclasses.replace(scenario.output, fields=("x", "stress")))
     t0 = time.perf_counter()
     res = run(sc, path, device="cpu", overwrite=True, n_threads=threads, callback=lambda sim, frame: not decided(sim))
@@ -76,14 +78,26 @@ def run_series(scenario, path: str, threads: int) -> dict:
                    key=lambda n: int(n.rsplit("_", 1)[-1]) if "_" in n else 0)
     with h5py.File(path, "r") as f:
         groups = [g["name"] if isinstance(g, dict) else g for g in json.loads(f.attrs["groups"])]
-        member = f["static/group"][:]
+        member, x0 = f["static/group"][:], f["static/x0"][:]
+        slab = np.isin(member, [groups.index(n) for n in slabs])
+        strength = np.zeros(member.size)
+        for name in slabs:
+            strength[member == groups.index(name)] = sc.materials[name].tensile_strength
+        top = x0[slab, 1].max()
         ratio = np.empty((f["time"].shape[0], len(slabs)))
+        peak_at = []
         for k in range(ratio.shape[0]):
-            s1 = principal_2d(f["particles/stress"][k])
+            stress = f["particles/stress"][k]
+            s1 = principal_2d(stress)
             for j, name in enumerate(slabs):
                 ratio[k, j] = s1[member == groups.index(name)].max() / sc.materials[name].tensile_strength
+            i = np.flatnonzero(slab)[np.argmax(s1[slab] / strength[slab])]
+            sig = stress[i]
+            peak_at.append([float(x0[i, 0]), float(top - x0[i, 1]), float(sig[0, 0]), float(sig[1, 1]),
+                            float(sig[0, 1])])
         series = {"t": f["time"][:].tolist(), "saw": f["scalars/saw"][:].tolist(),
-                  "front": f["scalars/front"][:].tolist(), "ratio": ratio.tolist()}
+                  "front": f["scalars/front"][:].tolist(), "ratio": ratio.tolist(),
+                  "peak_at": peak_at}
     o = res.scene_result.get("outcome", {})
     return {"series": series, "layers": slabs, "predicted": o.get("class"), "wall_s": wall}
 
@@ -136,7 +150,9 @@ def case_row(rec: dict, run_dir: str, tmp: str, threads: int) -> dict:
     layers = [{"thickness_m": ly.thickness, "density": ly.density, "cells": ly.thickness / p.dx,
                "tensile_strength": ly.strength, "peak_ratio": max(row[j] for row in s["ratio"])}
               for j, ly in enumerate(p.slab_stack())]
+    peak_frame = int(np.argmax([max(row) for row in s["ratio"]]))
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "predicted_batch": rec["predicted"],
+            "peak_at": s["peak_at"][peak_frame],
             "predicted": out["predicted"], "slope_deg": p.slope_angle, "dx": p.dx, "slab_depth_m": p.slab_depth,
             "recorded_cut": rec["recorded_cut"],
             "onset_cut": onset, "runaway_cut": rec.get("runaway_cut"), "layers": layers,

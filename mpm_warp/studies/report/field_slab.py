@@ -48,6 +48,16 @@ def _thin(cases: list) -> str:
     return "; where the run and weac part: " + "; ".join(notes) if notes else ""
 
 
+def _where(at) -> str:
+    """``[x0, depth, sigma_xx, sigma_yy, sigma_xy]`` of the run's peak as words: where, and the stress it is."""
+    if not at:
+        return "-"
+    x, depth, sxx, syy, sxy = at
+    which = "along the bed" if abs(sxx) >= max(abs(syy), abs(sxy)) else (
+        "normal to the bed" if abs(syy) >= abs(sxy) else "shear")
+    return f"{fx(x, 2)} m, {fx(depth * 100, 1)} cm deep; {which} ({fx(max(sxx, syy, sxy) / 1e3, 1)} kPa)"
+
+
 def _selected(data: dict) -> str:
     sel = data.get("selection") or {"observed": "SF", "predicted": "END"}
     if sel.get("cases"):
@@ -73,7 +83,9 @@ def _command(d: dict, out: str = "") -> str:
                   "come to its tensile strength, and what does weac's static beam say at the same cut?")
 def render_slab_stress(data: dict, ctx) -> list[str]:
     cases = data["cases"]
-    heads = ["record", "predicted", "slab, top to bottom", "onset / recorded cut (m)", "run: peak", "run: to onset",
+    where = any(c.get("peak_at") for c in cases)
+    heads = ["record", "predicted", "slab, top to bottom", "onset / recorded cut (m)", "run: peak",
+             *(["run's peak: where, which stress"] if where else []), "run: to onset",
              "weac at onset: over the cut, tip", "weac at the recorded cut: over the cut, tip", "run against weac",
              "wall time"]
     rows = []
@@ -82,7 +94,8 @@ def render_slab_stress(data: dict, ctx) -> list[str]:
         off = _off(c)
         rows.append([f"`{c['test']}`", c["predicted"], _layers(c),
                      f"{_r(c['onset_cut'])} / {fx(c['recorded_cut'], 2)}", _r(c["mpm_peak_ratio"]),
-                     _r(c["mpm_ratio_to_onset"]), f"{_r(wo.get('over_cut'))}, {_r(wo.get('tip'))}",
+                     *([_where(c.get("peak_at"))] if where else []), _r(c["mpm_ratio_to_onset"]),
+                     f"{_r(wo.get('over_cut'))}, {_r(wo.get('tip'))}",
                      f"{_r(wr.get('over_cut'))}, {_r(wr.get('tip'))}", "-" if off is None else spct(off),
                      secs(c["wall_s"])])
     offs = [o for o in map(_off, cases) if o is not None]
