@@ -14,14 +14,12 @@ Usage: ``python benchmarks/field/disagreements.py RUNDIR [RUNDIR ...] --data DIR
 
 from __future__ import annotations
 
-import glob
-import json
 import os
 import statistics
 import sys
 import warnings
 
-from mpm_warp.field.batch import gather
+from mpm_warp.field.batch import gather, run_records
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -107,13 +105,7 @@ def main(argv=None) -> int:
     p.add_argument("--data", required=True, help="folder of CAAML files the batches read")
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
-    recs = []
-    for run_dir in args.runs:
-        for path in sorted(glob.glob(os.path.join(run_dir, "*.json"))):
-            with open(path) as fh:
-                r = json.load(fh)
-            if r.get("status") == "ok" and r.get("observed") and "predicted" in r:
-                recs.append({**r, "run_dir": run_dir})
+    recs = [{**r, "run_dir": run_dir} for r, run_dir in run_records(args.runs) if r.get("observed")]
     recs = recs[:6] if args.quick else recs
     cases, _ = gather([os.path.join(args.data, p) for p in sorted({r["pit"] for r in recs})], calibrate=False)
     by = {(c.pit, c.test): c for c in cases}

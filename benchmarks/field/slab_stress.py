@@ -23,7 +23,6 @@ folder. Minutes of CPU a case.
 from __future__ import annotations
 
 import dataclasses
-import glob
 import json
 import os
 import random
@@ -36,6 +35,7 @@ import h5py
 import numpy as np
 
 from mpm_warp.config import TimeControl
+from mpm_warp.field.batch import run_records
 from mpm_warp.field.protocol import decided
 from mpm_warp.io.checkpoint import read_checkpoint_meta
 from mpm_warp.loader import resolved_scenario
@@ -176,16 +176,9 @@ def main(argv=None) -> int:
     p.add_argument("--threads", type=int, default=1, help="CPU threads of each run (default 1)")
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
-    recs = []
-    for run_dir in args.runs:
-        for path in sorted(glob.glob(os.path.join(run_dir, "*.json"))):
-            with open(path) as fh:
-                r = json.load(fh)
-            if r.get("status") != "ok" or "predicted" not in r:
-                continue
-            if (r["id"] in args.cases) if args.cases else (r.get("observed") == args.observed
-                                                           and r["predicted"] == args.predicted):
-                recs.append((r, run_dir))
+    recs = [(r, run_dir) for r, run_dir in run_records(args.runs)
+            if ((r["id"] in args.cases) if args.cases else
+                (r.get("observed") == args.observed and r["predicted"] == args.predicted))]
     if args.sample is not None and args.sample < len(recs):
         recs = random.Random(args.seed).sample(sorted(recs, key=lambda rd: rd[0]["id"]), args.sample)
     recs = recs[:1] if args.quick else recs

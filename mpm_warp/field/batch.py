@@ -22,6 +22,7 @@ import glob
 import hashlib
 import json
 import os
+import statistics
 import sys
 import time
 import traceback
@@ -38,7 +39,7 @@ from .static_rule import weac_static_class
 from .table import table_profiles
 from .uncertainty import balanced_accuracy_intervals
 
-__all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "FieldBatch"]
+__all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "run_records", "FieldBatch"]
 
 
 @dataclass
@@ -136,6 +137,19 @@ def finished_records(cases: list, out_dir: str) -> list[dict]:
     batch stopped early has measured, scored without running or building anything."""
     recs = (_finished({"out_dir": out_dir, "id": _case_id(c, k)}) for k, c in enumerate(cases))
     return [r for r in recs if r is not None]
+
+
+def run_records(run_dirs) -> list[tuple[dict, str]]:
+    """``(record, run_dir)`` of every case in the batches' runs folders ``run_dirs`` whose run finished with a
+    prediction (``status`` ok), in file order: what the analyses of a batch read."""
+    out = []
+    for run_dir in run_dirs:
+        for path in sorted(glob.glob(os.path.join(run_dir, "*.json"))):
+            with open(path) as fh:
+                r = json.load(fh)
+            if r.get("status") == "ok" and "predicted" in r:
+                out.append((r, run_dir))
+    return out
 
 
 def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
@@ -277,9 +291,5 @@ def score_records(recs: list) -> dict:
     return {"cases": len(ok), "failed": sum(r.get("status") != "ok" for r in recs),
             **{name: scores(obs, p) for name, p in pred.items()},
             "uncertainty": balanced_accuracy_intervals(obs, pred, reference="model"),
-            "wall_s": {"median": _median([r["wall_s"] for r in ok]), "total": sum(r["wall_s"] for r in ok)}}
-
-
-def _median(xs):
-    xs = sorted(xs)
-    return None if not xs else (xs[len(xs) // 2] if len(xs) % 2 else 0.5 * (xs[len(xs) // 2 - 1] + xs[len(xs) // 2]))
+            "wall_s": {"median": statistics.median(walls) if (walls := [r["wall_s"] for r in ok]) else None,
+                       "total": sum(r["wall_s"] for r in ok)}}

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scores import FIELD_CLASSES
+from .scores import FIELD_CLASSES, scores
 
 __all__ = ["balanced_accuracy_intervals"]
 
@@ -71,8 +71,7 @@ def balanced_accuracy_intervals(observed: list[str], predictions: dict[str, list
         values[name] = _balanced(hits, groups)
         out["intervals"][name] = [float(v) for v in np.percentile(values[name], [tail, 100.0 - tail])]
     ref = values[reference]
-    point = {name: float(np.mean([(obs[m] == np.asarray(p, dtype=object)[m]).mean() for m in members]))
-             for name, p in predictions.items()}
+    point = {name: scores(observed, p)["balanced_accuracy"] for name, p in predictions.items()}
     for name in predictions:
         if name == reference:
             continue
