@@ -30,7 +30,19 @@ import argparse
 import os
 import sys
 
-from . import convergence, field, field_slab, main_job, perf, robustness, scaling, snow_runs, snow_studies, snowpack  # noqa: F401
+from . import (  # noqa: F401
+    convergence,
+    field,
+    field_slab,
+    field_slab_fe,
+    main_job,
+    perf,
+    robustness,
+    scaling,
+    snow_runs,
+    snow_studies,
+    snowpack,
+)
 from .core import DOC, SECTIONS, Context, document, pending, section
 from .readme import block, headlines, with_block
 
