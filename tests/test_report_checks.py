@@ -21,7 +21,8 @@ COMPARING = {"Error against run time: the reference problems": 2,
              "Steady crack speed on 8 m columns": 3, "weac's static answers for the ladder PST": 1,
              "Stress at the weak layer's interfaces": 1, "The three field outcomes: END, SF, ARR": 4,
              "The snowpack's critical cut: layering and column ends": 5, "Why the slab did not break": 2,
-             "The slab's stress where the observer saw END": 1}
+             "The slab's stress where the observer saw END": 1,
+             "A resolved slab: the run and weac against a static FE": 4}
 LINE = re.compile(r"^- \*\*Check, [^*]+:\*\* .+: \*\*(pass|FAIL|open)\*\*( \(.+\))?\.$")
 
 

@@ -110,9 +110,9 @@ def render_slab_fe(data: dict, ctx) -> list[str]:
                        bool(off_b) and all(abs(d) <= AGREE for d in off_b),
                        f"{sum(abs(d) <= AGREE for d in off_b)} of {len(off_b)}; the run over the FE "
                        f"{fx(min(r / f for *_, r, f in basal), 1)} to {fx(max(r / f for *_, r, f in basal), 0)} "
-                       f"times, median {fx(median(r / f for *_, r, f in basal), 1)}: the slab particles that share "
-                       "grid cells with the weak layer carry its strain (docs/model.md §5b), a stress the continuum "
-                       "does not have" if off_b else "none"),
+                       f"times, median {fx(median(r / f for *_, r, f in basal), 1)}: a stress the static continuum "
+                       "does not have, in the rows whose stencil spans the weak layer's stiffness jump, where "
+                       "docs/model.md §5b measures the grid's smearing" if off_b else "none"),
             check_line("weac's static beam against the FE", f"the slab's peak within {fx(100 * AGREE, 0)} % at "
                        "the onset", bool(wf) and all(abs(d) <= AGREE for d in wf),
                        f"{sum(abs(d) <= AGREE for d in wf)} of {len(wf)}; from {spct(min(wf))} to {spct(max(wf))}, "
