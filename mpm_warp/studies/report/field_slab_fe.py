@@ -48,6 +48,16 @@ def _pairs(cases: list, basal: bool) -> list[tuple[str, int, float, float, float
     return out
 
 
+def _auc(cases: list, value) -> tuple[float, int] | None:
+    """How often ``value(case)`` ranks an observed SF record above an END one (ties half), and the pairs."""
+    sf = [value(c) for c in cases if c["observed"] == "SF"]
+    end = [value(c) for c in cases if c["observed"] == "END"]
+    if not sf or not end:
+        return None
+    wins = sum(1.0 if a > b else 0.5 if a == b else 0.0 for a in sf for b in end)
+    return wins / (len(sf) * len(end)), len(sf) * len(end)
+
+
 def _off(pairs) -> list[float]:
     return [run / fe - 1.0 for _, _, _, run, fe in pairs]
 
@@ -117,4 +127,11 @@ def render_slab_fe(data: dict, ctx) -> list[str]:
                        "the onset", bool(wf) and all(abs(d) <= AGREE for d in wf),
                        f"{sum(abs(d) <= AGREE for d in wf)} of {len(wf)}; from {spct(min(wf))} to {spct(max(wf))}, "
                        f"median {spct(median(wf))}" if wf else "none"), ""]
+    fe_auc = _auc(cases, lambda c: c["at_onset"]["fe"][-1]["peak"])
+    run_auc = _auc(cases, lambda c: c["run_to_onset"])
+    if fe_auc and run_auc:
+        out += [f"- **SF against END at the onset:** the FE's slab peak ranks an SF record above an END record in "
+                f"{fx(100 * fe_auc[0], 0)} % of the {fe_auc[1]} pairs, the run's largest slab stress to the onset "
+                f"in {fx(100 * run_auc[0], 0)} % (50 % is chance; the SF records are those the model called END, "
+                "the END records a sample of those it called END).", ""]
     return out + [env_note(data)]
