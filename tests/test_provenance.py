@@ -107,7 +107,6 @@ KNOWN_DIRTY = {
     "snow/results/snow_critical_cut.json":
         "python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope",   # hours
     "snow/results/snow_long_speed_trends.json": "python benchmarks/snow/long_speed_trends.py",   # hours
-    "snow/results/snowpack_critical_cut.json": "python benchmarks/snow/snowpack_critical_cut.py",  # hours
 }
 
 
