@@ -110,6 +110,26 @@ def run_layers_to(case: dict, cut: float | None, last: bool = False) -> list | N
     return [float(v) for v in (rows[-1] if last else np.max(rows, axis=0))]
 
 
+def run_peak_at_onset(case: dict, column, cut: float | None) -> dict | None:
+    """Where the run's slab peak sat in the onset frame (the slab-stress study's ``peak_at``): along the column from
+    the cut end's face at its depth (m), depth (m), the stresses (Pa), and its zone: ``blade`` (within
+    :data:`CORNER_M` of the blade along the column), ``end face`` (of either end face), else ``inside``."""
+    s = case["series"]
+    if cut is None or not s.get("peak_at"):
+        return None
+    k = max(i for i, saw in enumerate(s["saw"]) if saw <= cut + 1e-9)
+    x0, depth, sxx, syy, sxy = s["peak_at"][k]
+    h = sum(ly[0] for ly in column.slab)
+    shear = -np.tan(np.radians(column.slope_angle)) if column.column_ends == "vertical" else 0.0
+    from_face = x0 - shear * (h - depth)                    # from the upslope end's face at that depth
+    if column.cut_from == "downslope":
+        from_face = column.length - from_face
+    zone = ("blade" if abs(from_face - s["saw"][k]) <= CORNER_M else
+            "end face" if min(from_face, column.length - from_face) <= CORNER_M else "inside")
+    return {"from_end_face": float(from_face), "depth": float(depth), "sigma": [sxx, syy, sxy], "zone": zone,
+            "blade": float(s["saw"][k])}
+
+
 def case_row(case: dict, run_dir: str, meshes) -> dict:
     ck = os.path.join(run_dir, case["id"] + ".ckpt.h5")
     p = resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck).scene
@@ -119,7 +139,7 @@ def case_row(case: dict, run_dir: str, meshes) -> dict:
            "layer_cells": [ly["cells"] for ly in case["layers"]], "onset_cut": case["onset_cut"],
            "run_to_onset": case["mpm_ratio_to_onset"], "run_layers_to_onset": run_layers_to(case, case["onset_cut"]),
            "run_layers_at_onset": run_layers_to(case, case["onset_cut"], last=True),
-           "run_peak_at": case.get("peak_at")}
+           "run_peak_at": case.get("peak_at"), "run_peak_at_onset": run_peak_at_onset(case, col, case["onset_cut"])}
     if case["onset_cut"]:
         row["at_onset"] = compare(col, strengths, case["onset_cut"], meshes)
     return row

@@ -58,6 +58,28 @@ def _auc(cases: list, value) -> tuple[float, int] | None:
     return wins / (len(sf) * len(end)), len(sf) * len(end)
 
 
+def _peak(c: dict) -> str:
+    """The run's slab peak in the onset frame: its zone, depth and which stress it is."""
+    at = c.get("run_peak_at_onset")
+    if not at:
+        return "-"
+    sxx, syy, sxy = at["sigma"]
+    which = "along the bed" if abs(sxx) >= max(abs(syy), abs(sxy)) else (
+        "normal to the bed" if abs(syy) >= abs(sxy) else "shear")
+    return f"{at['zone']}, {fx(at['from_end_face'], 2)} m, {fx(at['depth'] * 100, 1)} cm deep, {which}"
+
+
+def _zones(cases: list, basal: list) -> str:
+    """Where the run's peak sat in the onset frame, over the records of ``basal``'s pairs that part from the FE."""
+    tests = {t for (t, _, _, r, f) in basal if abs(r / f - 1.0) > AGREE}
+    zones = [c["run_peak_at_onset"]["zone"] for c in cases if c["test"] in tests and c.get("run_peak_at_onset")]
+    if not zones:
+        return ""
+    words = {"blade": "at the blade", "end face": "at an end face", "inside": "inside the column"}
+    return "; in those records the run's slab peak of the onset frame sat " + ", ".join(
+        f"{zones.count(z)} {w}" for z, w in words.items() if zones.count(z))
+
+
 def _off(pairs) -> list[float]:
     return [run / fe - 1.0 for _, _, _, run, fe in pairs]
 
@@ -78,7 +100,9 @@ def render_slab_fe(data: dict, ctx) -> list[str]:
            "the sawn weak layer ends and of the column's end faces, where linear elasticity is singular (the "
            "edges column: their largest value on the finer mesh). The run's is its own, over the whole slab, while "
            "the blade had cut no more than the onset (the dynamics of the saw and the settling included), and in the "
-           "frame of the onset itself, which the checks compare. The layers at the base are those whose base lies "
+           "frame of the onset itself, which the checks compare, with where its slab peak sat then: at the blade or "
+           f"an end face (within {fx(data['corner_m'] * 100, 0)} cm along the column), or inside. The layers at the "
+           "base are those whose base lies "
            f"within {fx(STENCIL_CELLS, 0)} grid cells of the weak layer: the grid's stencil spans both.", ""]
     ctl = data.get("control")
     if ctl:
@@ -101,10 +125,11 @@ def render_slab_fe(data: dict, ctx) -> list[str]:
                      ", ".join(fx(v, 1) for v in c["layer_cells"]), ", ".join(fx(v, 2) for v in fe["layers"]),
                      ", ".join(fx(v, 2) for v in c.get("run_layers_at_onset") or []),
                      ", ".join(fx(v, 2) for v in c.get("run_layers_to_onset") or []), fx(fe["edges"], 2),
-                     _v(o["weac"]["peak"]), spct(o["fe_refinement_change"])])
+                     _peak(c), _v(o["weac"]["peak"]), spct(o["fe_refinement_change"])])
     out += table(["record", "observed", "onset (m)", "layers' cells, top to bottom", "FE per layer",
-                  "run per layer, at the onset", "run per layer, largest to the onset", "FE edges", "weac",
-                  "FE under refinement"], rows)
+                  "run per layer, at the onset", "run per layer, largest to the onset", "FE edges",
+                  "run's peak at the onset: zone, from the cut end, depth, stress", "weac", "FE under refinement"],
+                 rows)
     above, basal = _pairs(cases, basal=False), _pairs(cases, basal=True)
     off_a, off_b = _off(above), _off(basal)
     bad = [f"`{t}` layer {k + 1} ({fx(cells, 1)} cells): {fx(r, 2)} against {fx(f, 2)}"
@@ -121,8 +146,7 @@ def render_slab_fe(data: dict, ctx) -> list[str]:
                        f"{sum(abs(d) <= AGREE for d in off_b)} of {len(off_b)}; the run over the FE "
                        f"{fx(min(r / f for *_, r, f in basal), 1)} to {fx(max(r / f for *_, r, f in basal), 0)} "
                        f"times, median {fx(median(r / f for *_, r, f in basal), 1)}: a stress the static continuum "
-                       "does not have, in the rows whose stencil spans the weak layer's stiffness jump, where "
-                       "docs/model.md §5b measures the grid's smearing" if off_b else "none"),
+                       "does not have away from its singular corners" + _zones(cases, basal) if off_b else "none"),
             check_line("weac's static beam against the FE", f"the slab's peak within {fx(100 * AGREE, 0)} % at "
                        "the onset", bool(wf) and all(abs(d) <= AGREE for d in wf),
                        f"{sum(abs(d) <= AGREE for d in wf)} of {len(wf)}; from {spct(min(wf))} to {spct(max(wf))}, "
