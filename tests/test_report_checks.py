@@ -105,3 +105,15 @@ def test_the_slab_stress_peak_reads_as_where_and_which_stress():
     assert _where([0.989, 0.341, 2242.9, 13690.1, 1858.7]) == "0.99 m, 34.1 cm deep; normal to the bed (13.7 kPa)"
     assert _where([0.45, 0.002, 3464.0, -6.0, 8.0]) == "0.45 m, 0.2 cm deep; along the bed (3.5 kPa)"
     assert _where(None) == "-"
+
+
+def test_the_layers_at_the_base_are_those_within_the_stencil_of_the_weak_layer():
+    from mpm_warp.studies.report.field_slab_fe import _at_base
+
+    # a 1.3-cell basal layer puts the 4-cell layer above it within 2 cells of the weak layer, not the top one
+    assert _at_base({"layer_cells": [46.7, 4.0, 1.3]}) == {1, 2}
+    assert _at_base({"layer_cells": [41.3, 2.7]}) == {1}
+    assert _at_base({"layer_cells": [45.3]}) == {0}
+    # thin layers: every base within 2 cells of the weak layer (the top one at 1.4), or all but the top one (2.2)
+    assert _at_base({"layer_cells": [1.0, 0.7, 0.7]}) == {0, 1, 2}
+    assert _at_base({"layer_cells": [1.0, 1.5, 0.7]}) == {1, 2}
