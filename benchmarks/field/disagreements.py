@@ -5,7 +5,9 @@ scored case by what the observer recorded and what the run did: the slab's bed-n
 the slope, the cut as a share of the column, where the weak layer's fracture energy came from (read back from
 the recorded cut, or the default), the run's runaway cut against the recorded one, and whether the slab
 cracked anywhere (its largest effective tensile stress over its strength, from the final checkpoint: ``kappa``,
-docs/model.md §9). Groups them by observed and predicted class. Nothing here changes the model: it is the
+docs/model.md §9), and whether a static energy balance could stop the crack before the far end: the least of
+weac's energy release rate (with touchdown) beyond the recorded cut over the fracture energy the run took.
+Groups them by observed and predicted class. Nothing here changes the model: it is the
 evidence for which physics is missing. Writes ``benchmarks/field/results/field_disagreements.json``.
 
 Usage: ``python benchmarks/field/disagreements.py RUNDIR [RUNDIR ...] --data DIR``  (DIR: the unpacked pits).
@@ -53,6 +55,33 @@ def from_checkpoint(run_dir: str, case_id: str) -> tuple[float | None, float | N
                for g in groups), dt_ratio
 
 
+#: m: the energy balance is read up to this far from the far end (where the cut column's last strip lets go)
+FAR_END_M = 0.05
+#: cuts at which weac's G is read between the recorded cut and the far end
+ENERGY_POINTS = 12
+
+
+def energy_beyond_cut(run_dir: str, rec: dict) -> float | None:
+    """The least of weac's G (touchdown on) between the recorded cut and :data:`FAR_END_M` before the far end,
+    over the run's fracture energy ``w_f``: below 1, a static energy balance stops the crack there (an ARR that
+    needs no dynamics); None without weac or a checkpoint, or when the cut is within that distance of the end."""
+    import numpy as np
+
+    from mpm_warp.io.checkpoint import read_checkpoint_meta
+    from mpm_warp.loader import resolved_scenario
+    from mpm_warp.scenes.pst.static import static_column
+    from mpm_warp.scenes.weac_reference import energy_release_rate, weac_unavailable
+
+    ck = os.path.join(run_dir, rec["id"] + ".ckpt.h5")
+    if weac_unavailable() is not None or not os.path.exists(ck):
+        return None
+    col = static_column(resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck).scene)
+    if rec["recorded_cut"] >= col.length - FAR_END_M:
+        return None
+    cuts = np.linspace(rec["recorded_cut"], col.length - FAR_END_M, ENERGY_POINTS)
+    return min(energy_release_rate(col, float(a), touchdown=True)[0] for a in cuts) / rec["w_f"]
+
+
 def describe(rec: dict, case, run_dir: str) -> dict:
     """One scored case: the observer's column and the run's outcome."""
     p, slab = case.params, case.column.slab
@@ -65,6 +94,7 @@ def describe(rec: dict, case, run_dir: str) -> dict:
             "w_f": rec["w_f"], "w_f_read_back": rec.get("w_f_source") == "read back",
             "recorded_cut": rec["recorded_cut"], "runaway_cut": rec.get("runaway_cut"),
             "slab_fracture_at": rec.get("slab_fracture_at"), "slab_crack_ratio": crack,
+            "energy_beyond_cut": energy_beyond_cut(run_dir, rec),
             "substratum_share": p.substratum_depth / (p.slab_depth + p.weak_layer_thickness + p.substratum_depth),
             "c_p_over_slab": dt_ratio, "particles": rec.get("particles"), "steps": rec.get("steps"),
             "wall_s": rec.get("wall_s")}
@@ -79,13 +109,15 @@ def group(rows: list[dict]) -> dict:
     """Counts and medians of one group of cases."""
     ratio = [r["runaway_cut"] / r["recorded_cut"] for r in rows if r["runaway_cut"] and r["w_f_read_back"]]
     cracked = [r for r in rows if r["slab_crack_ratio"] is not None]
+    energy = [r["energy_beyond_cut"] for r in rows if r.get("energy_beyond_cut") is not None]
     return {"cases": len(rows), "slab_depth_m": _median([r["slab_depth_m"] for r in rows]),
             "slab_density": _median([r["slab_density"] for r in rows]),
             "slope_deg": _median([r["slope_deg"] for r in rows]), "cut_share": _median([r["cut_share"] for r in rows]),
             "w_f_read_back": sum(r["w_f_read_back"] for r in rows),
             "runaway_over_recorded": _median(ratio), "runaway_over_recorded_cases": len(ratio),
             "slab_cracked": sum(r["slab_crack_ratio"] >= 1.0 for r in cracked), "slab_checked": len(cracked),
-            "weac_static_SF": sum(r["static_class"] == "SF" for r in rows)}
+            "weac_static_SF": sum(r["static_class"] == "SF" for r in rows),
+            "energy_stops": sum(e < 1.0 - 1e-6 for e in energy), "energy_checked": len(energy)}
 
 
 def cost(rows: list[dict]) -> dict:

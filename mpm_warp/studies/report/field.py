@@ -221,7 +221,8 @@ def _group_row(name: str, g: dict) -> list[str]:
              if g.get("runaway_over_recorded") is not None else "-")
     return [name, count(g["cases"]), fx(g["slab_depth_m"], 0, 100), fx(g["slab_density"], 0), fx(g["slope_deg"], 0),
             pct(g["cut_share"], 0) if g.get("cut_share") is not None else "-", count(g["w_f_read_back"]), ratio,
-            f"{g['slab_cracked']} of {g['slab_checked']}", count(g["weac_static_SF"])]
+            f"{g['slab_cracked']} of {g['slab_checked']}", count(g["weac_static_SF"]),
+            f"{g['energy_stops']} of {g['energy_checked']}" if "energy_checked" in g else "-"]
 
 
 @section("field", "Where the model and the observers disagree", "field/results/field_disagreements.json",
@@ -231,12 +232,15 @@ def _group_row(name: str, g: dict) -> list[str]:
          question="What do the columns the model gets wrong have in common (docs/field.md)?")
 def render_disagreements(data: dict, ctx) -> list[str]:
     heads = ["observed -> predicted", "cases", "slab depth (cm)", "slab density (kg/m^3)", "slope (deg)",
-             "cut / column", "w_f read back", "runaway / recorded cut (cases)", "slab cracked", "weac static: SF"]
+             "cut / column", "w_f read back", "runaway / recorded cut (cases)", "slab cracked", "weac static: SF",
+             "G falls below w_f beyond the cut"]
     rows = [_group_row(f"{k} (all)", g) for k, g in data["by_observed"].items() if g["cases"]]
     rows += [_group_row(k.replace("->", " -> "), g) for k, g in data["by_pair"].items()]
     return (["Medians over each group of the batch's scored cases; counts where a column is a count. The slab cracked: "
              "its largest effective tensile stress reached its strength somewhere (kappa, docs/model.md §9), "
-             "whether or not it broke through.", ""]
+             "whether or not it broke through. G falls below w_f: weac's energy release rate (touchdown on), read at "
+             "12 cuts from the recorded one to 5 cm before the far end, drops below the fracture energy the run "
+             "took, so that a static energy balance alone would stop the crack (docs/field.md).", ""]
             + table(heads, rows) + _substratum(data.get("cost")) + ["", env_note(data, verb="computed")])
 
 
