@@ -28,20 +28,26 @@ from mpm_warp.studies.protocol import out_dir, parser
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 
-def from_checkpoint(run_dir: str, case_id: str) -> tuple[float | None, float | None]:
-    """From the run's final checkpoint: the slab's largest ``kappa / tensile strength`` (>= 1: it cracked
-    somewhere), and the fastest material's P-wave speed over the slab's fastest (> 1: the substratum, not the
-    slab, sets the time step); Nones without a checkpoint."""
-    import h5py
-
+def scenario_of(run_dir: str, case_id: str):
+    """The scenario a case ran (from its final checkpoint), or None without one."""
     from mpm_warp.io.checkpoint import read_checkpoint_meta
     from mpm_warp.loader import resolved_scenario
+
+    ck = os.path.join(run_dir, case_id + ".ckpt.h5")
+    return resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck) if os.path.exists(ck) else None
+
+
+def from_checkpoint(run_dir: str, case_id: str, sc) -> tuple[float | None, float | None]:
+    """From the run's final checkpoint: the slab's largest ``kappa / tensile strength`` (>= 1: it cracked
+    somewhere), and the fastest material's P-wave speed over the slab's fastest (> 1: the substratum, not the
+    slab, sets the time step); Nones without a checkpoint (``sc``: its scenario, :func:`scenario_of`)."""
+    import h5py
+
     from mpm_warp.model import Model
 
     ck = os.path.join(run_dir, case_id + ".ckpt.h5")
-    if not os.path.exists(ck):
+    if sc is None:
         return None, None
-    sc = resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck)
     model = Model(sc, "cpu")
     c_p = {name: m.p_wave_speed for name, m in sc.materials.items()}
     slab = max((v for k, v in c_p.items() if k.startswith("slab")), default=None)
@@ -61,21 +67,19 @@ FAR_END_M = 0.05
 ENERGY_POINTS = 12
 
 
-def energy_beyond_cut(run_dir: str, rec: dict) -> float | None:
+def energy_beyond_cut(sc, rec: dict) -> float | None:
     """The least of weac's G (touchdown on) between the recorded cut and :data:`FAR_END_M` before the far end,
     over the run's fracture energy ``w_f``: below 1, a static energy balance stops the crack there (an ARR that
-    needs no dynamics); None without weac or a checkpoint, or when the cut is within that distance of the end."""
+    needs no dynamics). ``sc``: the case's scenario (:func:`scenario_of`). None without weac or a checkpoint, or
+    when the cut is within that distance of the end."""
     import numpy as np
 
-    from mpm_warp.io.checkpoint import read_checkpoint_meta
-    from mpm_warp.loader import resolved_scenario
     from mpm_warp.scenes.pst.static import static_column
     from mpm_warp.scenes.weac_reference import energy_release_rate, weac_unavailable
 
-    ck = os.path.join(run_dir, rec["id"] + ".ckpt.h5")
-    if weac_unavailable() is not None or not os.path.exists(ck):
+    if weac_unavailable() is not None or sc is None:
         return None
-    col = static_column(resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck).scene)
+    col = static_column(sc.scene)
     if rec["recorded_cut"] >= col.length - FAR_END_M:
         return None
     cuts = np.linspace(rec["recorded_cut"], col.length - FAR_END_M, ENERGY_POINTS)
@@ -86,7 +90,8 @@ def describe(rec: dict, case, run_dir: str) -> dict:
     """One scored case: the observer's column and the run's outcome."""
     p, slab = case.params, case.column.slab
     depth = sum(ly.thickness for ly in slab)
-    crack, dt_ratio = from_checkpoint(run_dir, rec["id"])
+    sc = scenario_of(run_dir, rec["id"])
+    crack, dt_ratio = from_checkpoint(run_dir, rec["id"], sc)
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "predicted": rec["predicted"],
             "static_class": rec.get("static_class"), "slab_depth_m": p.slab_depth,
             "slab_density": sum(ly.thickness * ly.density for ly in slab) / depth, "slope_deg": p.slope_angle,
@@ -94,7 +99,7 @@ def describe(rec: dict, case, run_dir: str) -> dict:
             "w_f": rec["w_f"], "w_f_read_back": rec.get("w_f_source") == "read back",
             "recorded_cut": rec["recorded_cut"], "runaway_cut": rec.get("runaway_cut"),
             "slab_fracture_at": rec.get("slab_fracture_at"), "slab_crack_ratio": crack,
-            "energy_beyond_cut": energy_beyond_cut(run_dir, rec),
+            "energy_beyond_cut": energy_beyond_cut(sc, rec),
             "substratum_share": p.substratum_depth / (p.slab_depth + p.weak_layer_thickness + p.substratum_depth),
             "c_p_over_slab": dt_ratio, "particles": rec.get("particles"), "steps": rec.get("steps"),
             "wall_s": rec.get("wall_s")}

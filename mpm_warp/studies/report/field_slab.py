@@ -142,6 +142,12 @@ def render_slab_stress(data: dict, ctx) -> list[str]:
 SF_SOURCE = "field/results/field_slab_stress.json"
 
 
+def ranked_above(high: list, low: list) -> float:
+    """The share of pairs in which a value of ``high`` exceeds one of ``low`` (ties half): the area under the ROC
+    curve of telling the two apart by the value."""
+    return sum(1.0 if a > b else 0.5 if a == b else 0.0 for a in high for b in low) / (len(high) * len(low))
+
+
 @section("field", "The slab's stress where the observer saw END", "field/results/end/field_slab_stress.json",
          lambda d: _command(d, "benchmarks/field/results/end"),
          question="Beside the SF records: how close does the run's slab come to its strength in END records the "
@@ -152,13 +158,12 @@ def render_end(data: dict, ctx) -> list[str]:
     sf = [c["mpm_peak_ratio"] for c in (ctx.load(SF_SOURCE) or {}).get("cases", [])]
     end = [c["mpm_peak_ratio"] for c in data["cases"]]
     if sf and end:
-        wins = sum(1.0 if a > b else 0.5 if a == b else 0.0 for a in sf for b in end)
         reached = sum(v >= REACHED for v in sf)
         reached_end = sum(v >= REACHED for v in end)
         out[-1:-1] = [f"- **SF against END:** the run's peak slab stress over strength, median {fx(median(sf), 2)} "
                       f"in the {len(sf)} SF records (the section above) and {fx(median(end), 2)} in these "
                       f"{len(end)} END records. It ranks an SF record above an END record in "
-                      f"{fx(100 * wins / (len(sf) * len(end)), 0)} % of the {len(sf) * len(end)} pairs (the area "
+                      f"{fx(100 * ranked_above(sf, end), 0)} % of the {len(sf) * len(end)} pairs (the area "
                       f"under the ROC curve; 50 % is chance). The slab reached its strength (within "
                       f"{fx(100 * (1 - REACHED), 0)} %: the tensile law caps the stress there) in {reached} of the "
                       f"{len(sf)} SF records and in {reached_end} of these {len(end)} END records.", ""]

@@ -5,6 +5,7 @@ from __future__ import annotations
 from statistics import median
 
 from .core import section
+from .field_slab import ranked_above
 from .fmt import check_line, env_note, fx, spct, table
 
 #: a run's or weac's slab stress agrees with the resolved FE within this share (-): the line the control holds
@@ -54,8 +55,7 @@ def _auc(cases: list, value) -> tuple[float, int] | None:
     end = [value(c) for c in cases if c["observed"] == "END"]
     if not sf or not end:
         return None
-    wins = sum(1.0 if a > b else 0.5 if a == b else 0.0 for a in sf for b in end)
-    return wins / (len(sf) * len(end)), len(sf) * len(end)
+    return ranked_above(sf, end), len(sf) * len(end)
 
 
 def _peak(c: dict) -> str:
