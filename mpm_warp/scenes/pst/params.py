@@ -65,6 +65,11 @@ class PSTParams:
         each layer is the 2D run, at about 5x its cost). "slab" needs ``width = 0``.
     bed : {"sticky", "slip", "separate"}
         Wall kind under the substratum ("separate": Coulomb contact with ``bed_friction``).
+    rigid_base : bool
+        The weak layer rests on the bed itself, a rigid base, as in weac's model and the column FE
+        (docs/model.md §6): no substratum, so ``substratum``, ``substratum_thickness`` and ``substratum_layers``
+        must keep their defaults, and the bed must be "sticky". False (the default): the elastic old snow of the
+        substratum under the weak layer.
     bed_friction : float
         Coulomb coefficient of a "separate" bed (-), >= 0.
     margin : float
@@ -106,6 +111,7 @@ class PSTParams:
     plane_strain: PlaneStrain = "2d"
     bed: WallKind = "sticky"
     bed_friction: float = 0.5
+    rigid_base: bool = False
     margin: float = 0.05
     marker_spacing: float = 0.1
     slab: Slab = field(default_factory=Slab)
@@ -132,7 +138,9 @@ class PSTParams:
         finite_number(f"{where}.substratum_thickness", self.substratum_thickness, lo=0.0, lo_open=True)
         for part in ("slab", "substratum"):
             self._check_layers(part, where)
-        finite_number(f"{where}.substratum_thickness (of the layers)", self.substratum_depth, lo=2.0 * dx)
+        self._check_rigid_base(where)
+        if not self.rigid_base:
+            finite_number(f"{where}.substratum_thickness (of the layers)", self.substratum_depth, lo=2.0 * dx)
         self.profile.validate(f"{where}.profile")
         if not isinstance(self.slab_fracture, bool):
             raise InvalidArgument(f"{where}.slab_fracture", self.slab_fracture, "true or false")
@@ -186,6 +194,20 @@ class PSTParams:
         return [layer.cracking(self.crack_band) if self.slab_fracture else layer.slab().material()
                 for layer in self.slab_stack()]
 
+    def _check_rigid_base(self, where: str) -> None:
+        if not isinstance(self.rigid_base, bool):
+            raise InvalidArgument(f"{where}.rigid_base", self.rigid_base, "true or false")
+        if not self.rigid_base:
+            return
+        if self.bed != "sticky":
+            raise InvalidArgument(f"{where}.bed", self.bed, f"'sticky' with {where}.rigid_base = true (the weak "
+                                  "layer is bonded to the rigid base)")
+        default = type(self)()
+        for key in ("substratum_layers", "substratum_thickness", "substratum"):
+            if getattr(self, key) != getattr(default, key):
+                raise InvalidArgument(f"{where}.{key}", getattr(self, key), f"its default with {where}.rigid_base "
+                                      "= true (there is no substratum on a rigid base)")
+
     def _check_crack_band(self, where: str) -> None:
         for i, layer in enumerate(self.slab_stack()):
             mat = layer.cracking(self.crack_band)
@@ -198,14 +220,16 @@ class PSTParams:
 
     def to_dict(self) -> dict:
         """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back; ``interface_closure``
-        only when on and ``saw.stop`` only when "runaway", so the files of scenes without them are unchanged;
-        the layer lists only when given: :func:`upgrade_table` refuses empty ones)."""
+        and ``rigid_base`` only when on and ``saw.stop`` only when "runaway", so the files of scenes without them
+        are unchanged; the layer lists only when given: :func:`upgrade_table` refuses empty ones)."""
         d = asdict(self)
         for key in ("slab_layers", "substratum_layers"):
             if not d[key]:
                 del d[key]
         if not self.interface_closure:
             del d["interface_closure"]
+        if not self.rigid_base:
+            del d["rigid_base"]
         if self.saw.stop == "cut_length":
             del d["saw"]["stop"]
         return d
@@ -218,7 +242,9 @@ class PSTParams:
                                               s.fracture_energy),)
 
     def substratum_stack(self) -> tuple[SnowLayer, ...]:
-        """The substratum's layers, top to bottom."""
+        """The substratum's layers, top to bottom (none on a rigid base)."""
+        if self.rigid_base:
+            return ()
         s = self.substratum
         return self.substratum_layers or (SnowLayer(self.substratum_thickness, s.density, s.E, s.nu),)
 
@@ -234,7 +260,9 @@ class PSTParams:
 
     @property
     def substratum_depth(self) -> float:
-        """Thickness of the substratum (m)."""
+        """Thickness of the substratum (m; 0 on a rigid base)."""
+        if self.rigid_base:
+            return 0.0
         return self.substratum_thickness if not self.substratum_layers else stack_thickness(self.substratum_layers)
 
     def equivalent_slab(self) -> Slab:
