@@ -22,7 +22,8 @@ def cmd_field(a) -> int:
     from .field.protocol import FieldProtocol
 
     res = run_field(a.inputs, a.out, workers=a.workers, scheduler=a.scheduler, device=a.device, limit=a.limit,
-                    protocol=FieldProtocol(max_particles=a.max_particles, threads=a.threads), progress=not a.quiet)
+                    protocol=FieldProtocol(max_particles=a.max_particles, threads=a.threads,
+                                           rigid_base=not a.elastic_substratum), progress=not a.quiet)
     sc = res.scores
 
     def ba(k):
@@ -54,5 +55,7 @@ def add_field(sub) -> None:
                    help=f"per-case budget: most particles of a column (default {FieldProtocol.max_particles:,})")
     p.add_argument("--threads", type=int, default=FieldProtocol.threads,
                    help="CPU threads of each case's step (default 1); workers x threads should not exceed the cores")
+    p.add_argument("--elastic-substratum", action="store_true",
+                   help="run the weak layer on the profile's old snow instead of a rigid base (weac's column)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_field)

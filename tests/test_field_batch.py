@@ -112,3 +112,23 @@ def test_the_bootstrap_intervals_of_a_balanced_accuracy():
         balanced_accuracy_intervals(obs, {"model": half}, reference="model")
     with pytest.raises(ValueError, match="reference 'x' is not one of the predictors"):
         balanced_accuracy_intervals(obs, {"model": half}, reference="x")
+
+
+def test_the_protocol_runs_the_weak_layer_on_a_rigid_base_and_keys_its_cache_by_it(tmp_path):
+    """weac reads the fracture energy back on a rigid base; the run uses the same column unless asked not to, and a
+    batch's cached cases are reused only under the protocol that ran them (threads aside)."""
+    from mpm_warp.field.batch import _case_id
+    from mpm_warp.field.protocol import protocol_params
+
+    table = tmp_path / "psts.csv"
+    table.write_text(TABLE)
+    cases, _ = gather([str(table)], calibrate=False)
+    rigid, _, note = protocol_params(cases[0].params, FieldProtocol())
+    assert rigid.rigid_base and rigid.substratum_stack() == () and rigid.base_y == pytest.approx(0.04)
+    assert note.endswith(", on a rigid base") and "about 3,041 particles" in note   # 0.4 m x 0.19 m at 5 mm
+    old, _, note = protocol_params(cases[0].params, FieldProtocol(rigid_base=False))
+    assert not old.rigid_base and old.substratum_depth > 0.1 and "rigid" not in note
+    ids = {_case_id(cases[0], 0, FieldProtocol(**kw)) for kw in ({}, {"threads": 2}, {"rigid_base": False})}
+    assert len(ids) == 2
+    with pytest.raises(Exception, match="rigid_base = 1"):
+        FieldProtocol(rigid_base=1).validate()

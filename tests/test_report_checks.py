@@ -22,7 +22,8 @@ COMPARING = {"Error against run time: the reference problems": 2,
              "Stress at the weak layer's interfaces": 1, "The three field outcomes: END, SF, ARR": 4,
              "The snowpack's critical cut: layering and column ends": 5, "Why the slab did not break": 2,
              "The slab's stress where the observer saw END": 1,
-             "A resolved slab: the run and weac against a static FE": 4}
+             "A resolved slab: the run and weac against a static FE": 4,
+             "The rigid base: the same columns without their old snow": 2}
 LINE = re.compile(r"^- \*\*Check, [^*]+:\*\* .+: \*\*(pass|FAIL|open)\*\*( \(.+\))?\.$")
 
 

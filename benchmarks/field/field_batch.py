@@ -66,6 +66,8 @@ def main(argv=None) -> int:
     p.add_argument("--finished-only", action="store_true",
                    help="score the selected cases whose runs in --runs have finished, and run none (a batch stopped "
                         "early)")
+    p.add_argument("--elastic-substratum", action="store_true",
+                   help="run the weak layer on the profile's old snow instead of a rigid base (weac's column)")
     p.add_argument("--no-measured", action="store_true",
                    help="leave out the measured-density columns (a first, small sample: the stratified part only)")
     args = p.parse_args(argv)
@@ -79,17 +81,19 @@ def main(argv=None) -> int:
     runs = args.runs or tempfile.mkdtemp(prefix="mpm_warp_field_batch_")
     env = environment(args.device)
     t1 = time.perf_counter()
+    proto = FieldProtocol(max_particles=budget, threads=args.threads, rigid_base=not args.elastic_substratum)
     if args.finished_only:
-        recs = finished_records(chosen, runs)
+        recs = finished_records(chosen, runs, proto)
         batch = FieldBatch(recs, [], score_records(recs), len(recs), runs)
     else:
         batch = run_cases(chosen, [], runs, workers=args.workers, device=args.device,
-                          protocol=FieldProtocol(max_particles=budget, threads=args.threads), progress=True)
+                          protocol=proto, progress=True)
     wall = time.perf_counter() - t1
     ok = [r for r in batch.records if r.get("status") == "ok"]
     data = {"name": "field_batch", "data": os.path.basename(os.path.normpath(args.data)), "environment": env,
             "selection": {"runnable": len(cases), "refused": len(refused), **counts, "seed": args.seed,
                           "per_class": per, "max_particles": budget, "limit": args.limit,
+                          "protocol": proto.run_key(),
                           "finished_only": args.finished_only},
             "workers": args.workers, "threads_per_case": args.threads,
             "scores": batch.scores, "batch_wall_s": wall, "setup_wall_s": t1 - t0,

@@ -80,9 +80,10 @@ def gather(inputs, calibrate: bool = True) -> tuple[list[FieldCase], list[FieldR
     return cases, refused
 
 
-def _case_id(case: FieldCase, k: int) -> str:
+def _case_id(case: FieldCase, k: int, proto: FieldProtocol) -> str:
     stem = os.path.splitext(case.pit)[0].replace("#", "-").replace(" ", "_")
-    digest = hashlib.sha256(json.dumps(case.params.to_dict(), sort_keys=True, default=str).encode()).hexdigest()
+    key = {"case": case.params.to_dict(), "protocol": proto.run_key()}
+    digest = hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()
     return f"{stem}-{k}-{digest[:12]}"
 
 
@@ -132,10 +133,12 @@ def _finished(task: dict) -> dict | None:
     return io.finished_record(os.path.join(task["out_dir"], task["id"]))
 
 
-def finished_records(cases: list, out_dir: str) -> list[dict]:
-    """The records of ``cases`` (in order; :func:`run_cases`'s list) whose runs in ``out_dir`` have finished: what a
-    batch stopped early has measured, scored without running or building anything."""
-    recs = (_finished({"out_dir": out_dir, "id": _case_id(c, k)}) for k, c in enumerate(cases))
+def finished_records(cases: list, out_dir: str, protocol: FieldProtocol | None = None) -> list[dict]:
+    """The records of ``cases`` (in order; :func:`run_cases`'s list) whose runs in ``out_dir`` under ``protocol``
+    (default :class:`~.protocol.FieldProtocol`) have finished: what a batch stopped early has measured, scored
+    without running or building anything."""
+    proto = protocol or FieldProtocol()
+    recs = (_finished({"out_dir": out_dir, "id": _case_id(c, k, proto)}) for k, c in enumerate(cases))
     return [r for r in recs if r is not None]
 
 
@@ -167,7 +170,7 @@ def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
             refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, params), c.outcome))
             continue
         wf = c.fracture_energy
-        tasks.append({"id": _case_id(c, k), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
+        tasks.append({"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
                       "recorded_cut": c.record.cut_length, "static_class": weac_static_class(c.params),
                       "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
                       "setup": note, "scenario": scenario, "out_dir": out_dir,

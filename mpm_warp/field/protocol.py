@@ -6,6 +6,8 @@
 - **The grid** resolves the weak layer with 4 cells (the resolution the snow ladders call resolved) when the
   column then fits :attr:`FieldProtocol.max_particles`; else with 3, the fewest the model allows; else the
   case is refused in one line (the column is too large for the budget).
+- **The base**: the weak layer lies on a rigid base (``scene.rigid_base``), the column that weac reads the
+  fracture energy back with; the old snow under it is left out (docs/field.md, "The field protocol").
 - **The run** lasts the settling, the saw's way to the end, and :attr:`FieldProtocol.tail` after it, and stops
   at the first frame at which the outcome is decided (END, SF, an arrest after a runaway, no propagation).
 """
@@ -17,6 +19,7 @@ import math
 from dataclasses import dataclass
 
 from ..config import TimeControl
+from ..errors import InvalidArgument
 from ..scenes.pst import PSTParams
 
 __all__ = ["FieldProtocol", "protocol_params", "decided", "particle_estimate"]
@@ -38,6 +41,8 @@ class FieldProtocol:
         Simulated time after the saw reached the far end (s).
     frame_interval : float
         Time between frames (s): the outcome is checked at every frame.
+    rigid_base : bool
+        Run the weak layer on a rigid base (the default), or on the profile's old snow (False).
     threads : int
         CPU threads each case's step runs on (the CPU step's own threads; ignored on CUDA). A batch's workers
         times this should not exceed the cores: on 2 cores, 1 worker of 2 threads finishes each case sooner
@@ -49,6 +54,7 @@ class FieldProtocol:
     saw_speed: float = 1.0
     tail: float = 0.3
     frame_interval: float = 0.005
+    rigid_base: bool = True
     threads: int = 1
 
     def validate(self) -> FieldProtocol:
@@ -61,7 +67,16 @@ class FieldProtocol:
         finite_number("tail", self.tail, lo=0.0)
         finite_number("frame_interval", self.frame_interval, lo=0.0, lo_open=True, hi=0.1)
         positive_int("threads", self.threads, lo=1, hi=64)
+        if not isinstance(self.rigid_base, bool):
+            raise InvalidArgument("rigid_base", self.rigid_base, "true or false")
         return self
+
+    def run_key(self) -> dict:
+        """The fields that change what a case computes (all but ``threads``): a cached case is reused only under
+        the same ones."""
+        d = dataclasses.asdict(self)
+        del d["threads"]
+        return d
 
 
 def particle_estimate(p: PSTParams) -> int:
@@ -73,6 +88,10 @@ def particle_estimate(p: PSTParams) -> int:
 
 def protocol_params(params: PSTParams, proto: FieldProtocol) -> tuple[PSTParams | None, TimeControl | None, str]:
     """The field case ``params`` as the protocol runs it: ``(params, time, note)``, or ``(None, None, reason)``."""
+    if proto.rigid_base:
+        bare = PSTParams()
+        params = dataclasses.replace(params, rigid_base=True, substratum_layers=(), substratum=bare.substratum,
+                                     substratum_thickness=bare.substratum_thickness)
     saw_fields = {f.name for f in dataclasses.fields(params.saw)}
     saw = dataclasses.replace(params.saw, cut_length=float(params.length), speed=proto.saw_speed,
                               **({"stop": "runaway"} if "stop" in saw_fields else {}))
@@ -82,7 +101,8 @@ def protocol_params(params: PSTParams, proto: FieldProtocol) -> tuple[PSTParams 
         n = particle_estimate(p)
         if n <= proto.max_particles:
             end = p.saw_start + p.length / proto.saw_speed + proto.tail
-            note = f"{cells} cells across the weak layer, dx {dx * 1e3:.2f} mm, about {n:,} particles"
+            note = (f"{cells} cells across the weak layer, dx {dx * 1e3:.2f} mm, about {n:,} particles"
+                    + (", on a rigid base" if proto.rigid_base else ""))
             return p.validate("scene"), TimeControl(end=end, frame_interval=proto.frame_interval), note
     return None, None, (f"the column is too large for the per-case budget: {n:,} particles at the coarsest grid "
                         f"the weak layer allows (3 cells), above {proto.max_particles:,}")
