@@ -72,7 +72,19 @@ def _batch_command(d: dict, out: str = "") -> str:
             + (f" --threads {d['threads_per_case']}" if d.get("threads_per_case", 1) != 1 else "")
             + (f" --limit {sel['limit']}" if sel.get("limit") else "")
             + (" --finished-only" if sel.get("finished_only") else "")
+            + ("" if _rigid(sel) else " --elastic-substratum")
             + (f" --out {out}" if out else ""))
+
+
+def _rigid(sel: dict) -> bool:
+    """Whether the batch ran its columns on a rigid base (a file from before the protocol said so: the old snow)."""
+    return bool((sel.get("protocol") or {}).get("rigid_base"))
+
+
+def _base(sel: dict) -> str:
+    return ("The columns ran on a rigid base (the field protocol's)." if _rigid(sel) else
+            "The columns ran on the profile's old snow, as the field protocol did before the rigid base (the command "
+            "says `--elastic-substratum`).")
 
 
 def _interval(iv) -> str:
@@ -143,6 +155,7 @@ def render_batch(data: dict, ctx) -> list[str]:
         out = [f"Cases: {count(sc['cases'])} scored ({count(sc['failed'])} failed), {drawn}; {count(len(built))} of "
                "those refused when built (the per-case budget, or the calibration), in the JSON's "
                "`refused_at_build`.", ""]
+    out[-2] += " " + _base(sel)
     level = f" ({fx(100 * unc['level'], 0)} % interval)" if unc.get("intervals") else ""
     out += table(["predictor", "cases", f"balanced accuracy{level}", "recall END", "recall SF", "recall ARR"], rows)
     conf = sc["model"]["confusion"]

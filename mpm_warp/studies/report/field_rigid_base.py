@@ -21,6 +21,18 @@ def _change(c: dict):
     return None if not a or not b else b / a - 1.0
 
 
+def _far_note(cases: list) -> str:
+    """Where the cuts that moved beyond :data:`CUT_SHARE` stand in the substratum's compliance."""
+    far = [c for c in cases if (ch := _change(c)) is not None and abs(ch) > CUT_SHARE]
+    near = [c["compliance_ratio"] for c in cases if (ch := _change(c)) is not None and abs(ch) <= CUT_SHARE]
+    if not far or not near:
+        return ""
+    return (f" Those columns' old snow is {' and '.join(fx(c['compliance_ratio'], 2) for c in far)} times as "
+            f"compliant as their weak layer (the others' median {fx(median(near), 2)}), and on the rigid base their "
+            f"crack ran away at a {'longer' if all(_change(c) > 0 for c in far) else 'different'} cut: the old snow's "
+            "give, which weac's column does not have either, had let it run sooner.")
+
+
 @section("field", "The rigid base: the same columns without their old snow", "field/results/field_rigid_base.json",
          lambda d: "python benchmarks/field/rigid_base.py RUNDIR1 RUNDIR2  # the runs on the old snow",
          question="What changes when a field column's weak layer lies on a rigid base, as in weac, instead of on "
@@ -57,7 +69,8 @@ def render_rigid_base(data: dict, ctx) -> list[str]:
             f"(median {fx(median(ratios), 2)}) in these columns: not small. Leaving it out "
             + ("changed no class" if all(same) else f"changed the class in {len(same) - sum(same)}")
             + (f", and moved the runaway cut by more than twice the grid's own error in {len(far)} of {len(changes)}."
-               if far else ", and moved no runaway cut by more than twice the grid's own error."),
+               if far else ", and moved no runaway cut by more than twice the grid's own error.")
+            + _far_note(cases),
             f"- Cost: the rigid base took {fx(min(speed), 2)} to {fx(max(speed), 2)} times less wall time (median "
             f"{fx(median(speed), 2)}x; median {fx(median(c['substratum']['wall_s'] for c in cases), 0)} s on the old "
             f"snow, {fx(median(c['rigid']['wall_s'] for c in cases), 0)} s on the rigid base), from fewer particles "
