@@ -115,7 +115,7 @@ def test_saw_kerf_reference_and_damage_times(T):
     k = weak_layer_kernel(2, T)
     # reference until t_ref = 0.1 s; saw from t = 0.1 s at 1 m/s from x = 0, stops at 0.2 m; damage at bond 0.5
     blade_end = wp.array([0.2], dtype=wp.float64, device=DEVICE)   # the blade's end: read at every launch
-    args = [x, log_jp, kappa, ref, sawn, arrival, clock, 0.1, T(kappa_s), T(0.5), 0.1, 1.0, blade_end, 0.0, 1.0]
+    args = [x, log_jp, kappa, ref, sawn, arrival, clock, 0.1, T(kappa_s), T(0.5), 0.1, 1.0, blade_end, 0.0, 1.0, 0.0]
     wp.launch(k, n, inputs=args, device=DEVICE)   # settling: the reference follows, nobody sawn
     assert np.all(ref.numpy() == lj0) and np.all(sawn.numpy() == 0)
     assert arrival.numpy()[3] == 0.05 and np.isinf(arrival.numpy()[[0, 1, 2, 4, 5]]).all()
@@ -136,6 +136,16 @@ def test_saw_kerf_reference_and_damage_times(T):
     blade_end.assign([0.3])                       # the host moves the blade's end: the next launch reads it
     wp.launch(k, n, inputs=args, device=DEVICE)
     assert sawn.numpy().tolist() == [1, 1, 1, 0, 0, 0] and kappa.numpy()[2] == npT(kappa_s)
+    # a pre-cut of 0.2 m: the kerf is there while settling; the blade then advances from its end
+    kappa.assign(k0)
+    sawn.zero_()
+    clock.assign([0.0, 1e-4, 1.0, 1e-4])
+    pre = [*args[:-1], 0.2]
+    wp.launch(k, n, inputs=pre, device=DEVICE)
+    assert sawn.numpy().tolist() == [1, 1, 0, 0, 0, 0]
+    clock.assign([0.16, 1e-4, 1.0, 1e-4])         # 0.06 s of sawing from 0.2 m: the blade at 0.26 m
+    wp.launch(k, n, inputs=pre, device=DEVICE)
+    assert sawn.numpy().tolist() == [1, 1, 1, 0, 0, 0]
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -100,7 +100,7 @@ def protocol_params(params: PSTParams, proto: FieldProtocol) -> tuple[PSTParams 
         p = dataclasses.replace(params, dx=dx, margin=max(params.margin, 2.0 * dx), saw=saw)
         n = particle_estimate(p)
         if n <= proto.max_particles:
-            end = p.saw_start + p.length / proto.saw_speed + proto.tail
+            end = p.saw_start + (p.length - p.saw.pre_cut) / proto.saw_speed + proto.tail
             note = (f"{cells} cells across the weak layer, dx {dx * 1e3:.2f} mm, about {n:,} particles"
                     + (", on a rigid base" if proto.rigid_base else ""))
             return p.validate("scene"), TimeControl(end=end, frame_interval=proto.frame_interval), note

@@ -33,6 +33,7 @@ from ..fronts import bisect_threshold
 from .analysis import end_zone
 from .monitor import PSTMonitor, attach
 from .params import PSTParams
+from .saw import blade_time
 from .static import weac_answer
 
 __all__ = ["CriticalCut", "critical_cut", "cut_run"]
@@ -153,24 +154,27 @@ def critical_cut(scenario, lo: float, hi: float, tol: float = 0.02, run_distance
                          "a saw that stops on runaway estimates the critical cut from one run: runaway_cut)")
     if not 0.0 <= lo < hi <= p.length:
         raise ValueError(f"need 0 <= lo < hi <= length (got lo={lo}, hi={hi}, length={p.length})")
+    if p.saw.pre_cut > lo:
+        raise ValueError(f"saw.pre_cut = {p.saw.pre_cut} m is beyond lo = {lo} m: a trial cannot cut less than the "
+                         "pre-cut")
     if workers not in (1, 2):
         raise ValueError(f"workers = {workers}: need 1 (serial trials) or 2 (lo and the first midpoint at once)")
     wall0 = _time.perf_counter()
     step = float(snapshot_every or 0.5 * tol)
-    v, t_saw = float(p.saw.speed), p.saw_start
+    t_saw = p.saw_start
     # ---------------------------------------------------------------- base run: cut hi, snapshots while sawing
     base_sc = _with_cut(scenario, hi)
     sim, mon = _simulation(base_sc, device, n_threads)
     snaps = []                               # (blade position, snapshot), increasing
     sim.step_to(t_saw)
     a = min(lo, hi)                          # no trial starts before lo
-    _step_recording(sim, mon, t_saw + a / v, check_interval)
+    _step_recording(sim, mon, blade_time(p, a), check_interval)
     while True:
         snaps.append((a, sim.snapshot()))
         if a >= hi:
             break
         a = min(a + step, hi)
-        _step_recording(sim, mon, t_saw + a / v, check_interval)
+        _step_recording(sim, mon, blade_time(p, a), check_interval)
     base = _trial(sim, mon, hi, run_distance if base_run_distance is None else base_run_distance,
                   free_run if base_free_run is None else base_free_run, check_interval, classify)
     base_summary = mon.result()
@@ -245,7 +249,7 @@ def cut_run(scenario, cut: float, run_distance: float, free_run: float, check_in
         raise ValueError(f"cut = {cut} m: need 0 < cut <= length = {p.length} m")
     sim, mon = _simulation(_with_cut(scenario, cut), device, n_threads)
     sim.step_to(p.saw_start)
-    _step_recording(sim, mon, p.saw_start + cut / p.saw.speed, check_interval)
+    _step_recording(sim, mon, blade_time(p, cut), check_interval)
     out = _trial(sim, mon, cut, run_distance, free_run, check_interval)
     times, series = mon.series_arrays()
     return {**out, "steps": sim.stepper.clock()[2], "summary": mon.result(),
@@ -272,7 +276,7 @@ def _trial(sim: Simulation, mon: PSTMonitor, cut: float, run_distance: float, fr
     the time a crack at 5 m/s needs to cross the column."""
     p = mon.params
     goal = min(cut + run_distance, p.length - end_zone(p))
-    t_stop = p.saw_start + cut / p.saw.speed + free_run
+    t_stop = blade_time(p, cut) + free_run
     t_cap = t_stop + p.length / 5.0
     t = sim.time
     front, propagated = 0.0, False

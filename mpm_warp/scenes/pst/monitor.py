@@ -62,7 +62,8 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         self.sim = sim
         T = sim.model.T
         left = p.cut_at_origin
-        saw = (p.saw_start, p.saw.speed, p.saw.cut_length, 0.0 if left else float(p.length), 1.0 if left else -1.0)
+        saw = (p.saw_start, p.saw.speed, p.saw.cut_length, 0.0 if left else float(p.length), 1.0 if left else -1.0,
+               p.saw.pre_cut)
         self.weak = WeakLayerTracker(sim, "weak_layer", p.saw_start, saw)
         self.stopped_at = math.nan
         self.calibration = stored_calibration(sim.scenario)
@@ -77,7 +78,9 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         self.s_base = p.distance_from_cut_end(x0[base, 0])
         dev = sim.device
         self.base_y_ref = wp.array(x0[base, 1].astype(np.float64), dtype=wp.float64, device=dev)
-        self.base_arrival = wp.full(len(base), np.inf, dtype=wp.float64, device=dev)
+        # over a pre-cut the slab base is behind the front from the start, as over a kerf the saw made
+        self.base_arrival = wp.array(np.where(self.s_base <= p.saw.pre_cut, 0.0, np.inf) if p.saw.pre_cut > 0.0
+                                     else np.full(len(base), np.inf), dtype=wp.float64, device=dev)
         self.deflection_action = wp.launch(
             deflection_kernel(sim.model.dim, T), len(base),
             inputs=[self.slab.x, wp.array(base.astype(np.int32), dtype=wp.int32, device=dev), self.base_y_ref,

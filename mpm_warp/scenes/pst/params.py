@@ -160,6 +160,7 @@ class PSTParams:
         self.settle.validate(f"{where}.settle")
         finite_number(f"{where}.saw.cut_length", self.saw.cut_length, lo=0.0, hi=L)
         finite_number(f"{where}.saw.speed", self.saw.speed, lo=0.0, lo_open=True, hi=1.0)
+        finite_number(f"{where}.saw.pre_cut", self.saw.pre_cut, lo=0.0, hi=self.saw.cut_length)
         finite_number(f"{where}.front.bin", self.front.bin, lo=0.0)
         finite_number(f"{where}.front.deflection", self.front.deflection, lo=0.0, lo_open=True, hi=1.0)
         finite_number(f"{where}.front.runaway_lead", self.front.runaway_lead, lo=0.0, lo_open=True)
@@ -232,6 +233,8 @@ class PSTParams:
             del d["rigid_base"]
         if self.saw.stop == "cut_length":
             del d["saw"]["stop"]
+        if self.saw.pre_cut == 0.0:
+            del d["saw"]["pre_cut"]
         return d
 
     # ------------------------------------------------------------- the snowpack
@@ -311,7 +314,7 @@ class PSTParams:
     def saw_end(self) -> float:
         """Time the saw reaches ``saw.cut_length`` (s): where it stops unless it stopped on runaway before
         (:func:`.saw.sawn` gives the parameters of the cut made)."""
-        return self.saw_start + self.saw.cut_length / self.saw.speed
+        return self.saw_start + max(self.saw.cut_length - self.saw.pre_cut, 0.0) / self.saw.speed
 
     @property
     def bin_width(self) -> float:

@@ -18,7 +18,7 @@ from typing import Literal
 
 import numpy as np
 
-__all__ = ["Saw", "Front", "CutFrom", "SawStop", "sawn", "blade_position", "stop_record"]
+__all__ = ["Saw", "Front", "CutFrom", "SawStop", "sawn", "blade_position", "blade_time", "stop_record"]
 
 #: where the saw starts: the column's upslope or downslope end (on flat ground "upslope" is the end x = 0)
 CutFrom = Literal["upslope", "downslope"]
@@ -44,6 +44,11 @@ class Saw:
     cut_from : {"upslope", "downslope"}
         The end of the column it starts from. ``x`` runs downslope, so on a slope of positive angle the
         upslope end is ``x = 0``; on flat ground "upslope" names the end ``x = 0``.
+    pre_cut : float
+        Length already cut when the run starts (m), in [0, cut_length]: the kerf is there from t = 0, through
+        the settling, and the blade advances from it at ``speed`` once settling ends. Elastic and bonded short
+        of the critical cut, a column pre-cut to ``pre_cut`` settles into the state a slow saw leaves there,
+        without the simulated time of sawing it (docs/model.md §6). 0 (the default): the saw cuts from the end.
     stop : {"cut_length", "runaway"}
         Where the blade stops: "cut_length", at ``cut_length`` (the default); "runaway", where it is at the
         first frame the damage front leads it by ``front.runaway_lead`` (the field protocol: what follows is the
@@ -54,6 +59,7 @@ class Saw:
     speed: float = 1.0
     cut_length: float = 0.6
     cut_from: CutFrom = "upslope"
+    pre_cut: float = 0.0
     stop: SawStop = "cut_length"
 
 
@@ -93,9 +99,18 @@ def sawn(params, stopped_at: float = math.nan):
 
 
 def blade_position(params, t):
-    """Blade distance from the cut end (m) at times ``t`` (s; float or array): ``speed (t - saw_start)`` within
-    ``[0, saw.cut_length]`` (pass :func:`sawn` parameters for a saw that stopped on runaway)."""
-    return np.clip(params.saw.speed * (np.asarray(t, dtype=float) - params.saw_start), 0.0, params.saw.cut_length)
+    """Blade distance from the cut end (m) at times ``t`` (s; float or array): ``pre_cut + speed (t - saw_start)``
+    within ``[pre_cut, saw.cut_length]`` (pass :func:`sawn` parameters for a saw that stopped on runaway)."""
+    s = params.saw
+    moved = s.speed * np.maximum(np.asarray(t, dtype=float) - params.saw_start, 0.0)
+    return np.minimum(s.pre_cut + moved, s.cut_length)
+
+
+def blade_time(params, position: float) -> float:
+    """Time (s) the blade reaches ``position`` (m from the cut end): the end of settling for any position within
+    the pre-cut, ``saw_start + (position - pre_cut) / speed`` beyond it."""
+    s = params.saw
+    return params.saw_start + max(float(position) - s.pre_cut, 0.0) / s.speed
 
 
 def stop_record(params, stopped_at: float, runaway: float) -> dict:

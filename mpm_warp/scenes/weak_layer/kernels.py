@@ -20,8 +20,9 @@ def weak_layer_kernel(dim, T):
 
     - Reference: ``ref = log_jp`` while ``t < t_ref`` (the layer as it settled), then fixed; the
       collapse ``1 - exp(log_jp - ref)`` is measured from it.
-    - Saw (``saw_speed > 0``): from ``t_saw`` the blade sits at distance ``min(saw_speed (t - t_saw),
-      blade_end[0])`` (m) from ``x_start`` along ``direction`` (+1 or -1); a particle behind it loses its
+    - Saw (``saw_speed > 0``): the blade sits at distance ``min(pre_cut + saw_speed max(t - t_saw, 0),
+      blade_end[0])`` (m) from ``x_start`` along ``direction`` (+1 or -1): at the pre-cut's end from the
+      start, advancing from ``t_saw``; a particle behind it loses its
       bond (``kappa = max(kappa, kappa_s)``: a kerf, the layer cohesionless there and free to collapse
       under the slab) and is flagged ``sawn = 1``. ``blade_end`` is a 1-element device array (m), read
       every step: the cut length, or where the host stopped the blade between frames (a captured CUDA
@@ -36,15 +37,18 @@ def weak_layer_kernel(dim, T):
                    ref: wp.array(dtype=T), sawn: wp.array(dtype=wp.uint8), arrival: wp.array(dtype=wp.float64),
                    clock: wp.array(dtype=wp.float64), t_ref: wp.float64, kappa_s: T, damage_bond: T,
                    t_saw: wp.float64, saw_speed: wp.float64, blade_end: wp.array(dtype=wp.float64), x_start: wp.float64,
-                   direction: wp.float64):
+                   direction: wp.float64, pre_cut: wp.float64):
         i = wp.tid()
         t = clock[0]
         if t < t_ref:
             ref[i] = log_jp[i]
         k = kappa[i]
-        if saw_speed > wp.float64(0.0) and t >= t_saw:
+        reach = pre_cut
+        if t >= t_saw:
+            reach = pre_cut + saw_speed * (t - t_saw)
+        if saw_speed > wp.float64(0.0) and (t >= t_saw or pre_cut > wp.float64(0.0)):
             s = (wp.float64(x[i][0]) - x_start) * direction
-            if s <= wp.min(saw_speed * (t - t_saw), blade_end[0]):
+            if s <= wp.min(reach, blade_end[0]):
                 if k < kappa_s:
                     k = kappa_s
                     kappa[i] = k

@@ -47,9 +47,10 @@ class WeakLayerTracker:
         Name of the weak-layer particle group (a bonded Cam-Clay group).
     t_ref : float
         End of settling (s): the collapse reference is the state then.
-    saw : (t_start, speed, cut_length, x_start, direction) or None
-        The saw (s, m/s, m, m, +1/-1), or none (shear test). ``cut_length`` is the blade's end to begin with
-        (:attr:`blade_end`; :meth:`stop_blade` moves it between frames).
+    saw : (t_start, speed, cut_length, x_start, direction[, pre_cut]) or None
+        The saw (s, m/s, m, m, +1/-1; m, the length cut from the start, 0 without), or none (shear test).
+        ``cut_length`` is the blade's end to begin with (:attr:`blade_end`; :meth:`stop_blade` moves it between
+        frames).
 
     Attributes
     ----------
@@ -78,13 +79,13 @@ class WeakLayerTracker:
         self.ref = wp.array(np.full(view.count, m.initial_log_jp), dtype=T, device=sim.device)
         self.sawn = wp.zeros(view.count, dtype=wp.uint8, device=sim.device)
         self.arrival = wp.full(view.count, np.inf, dtype=wp.float64, device=sim.device)
-        t_saw, speed, cut, x_start, direction = saw if saw is not None else (math.inf, 0.0, 0.0, 0.0, 1.0)
+        t_saw, speed, cut, x_start, direction, *pre = saw if saw is not None else (math.inf, 0.0, 0.0, 0.0, 1.0)
         self.blade_end = wp.array([float(cut)], dtype=wp.float64, device=sim.device)
         self.launch = wp.launch(
             weak_layer_kernel(sim.model.dim, T), view.count,
             inputs=[view.x, self.log_jp, self.kappa, self.ref, self.sawn, self.arrival, sim.clock, float(t_ref),
                     T(m.kappa_s), T(DAMAGE_BOND), float(t_saw), float(speed), self.blade_end, float(x_start),
-                    float(direction)],
+                    float(direction), float(pre[0]) if pre else 0.0],
             device=sim.device, record_cmd=True)
 
     def bond(self) -> np.ndarray:
