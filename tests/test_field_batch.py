@@ -88,6 +88,8 @@ def test_bad_batch_arguments_are_one_line(tmp_path, capsys):
     assert "workers = 0 is invalid: expected an integer >= 1" in capsys.readouterr().err
     assert main(["field", str(table), "--out", str(tmp_path / "o"), "--threads", "0"]) == 2
     assert "threads = 0 is invalid" in capsys.readouterr().err
+    assert main(["field", str(table), "--out", str(tmp_path / "o"), "--pre-cut-share", "2"]) == 2
+    assert "pre_cut_share = 2" in capsys.readouterr().err
 
 
 def test_the_bootstrap_intervals_of_a_balanced_accuracy():
@@ -132,3 +134,21 @@ def test_the_protocol_runs_the_weak_layer_on_a_rigid_base_and_keys_its_cache_by_
     assert len(ids) == 2
     with pytest.raises(Exception, match="rigid_base = 1"):
         FieldProtocol(rigid_base=1).validate()
+
+
+def test_a_protocol_with_a_pre_cut_starts_each_column_sawn_a_share_of_weacs_critical_cut(tmp_path):
+    from mpm_warp.field.batch import _case_id
+    from mpm_warp.field.protocol import protocol_params
+
+    table = tmp_path / "psts.csv"
+    table.write_text(TABLE)
+    cases, _ = gather([str(table)], calibrate=False)
+    half = FieldProtocol(pre_cut_share=0.5)
+    p, tc, note = protocol_params(cases[0].params, half, static_cut=0.2)
+    assert p.saw.pre_cut == pytest.approx(0.1) and note.endswith(", pre-cut 10.0 cm")
+    assert tc.end == pytest.approx(p.saw_start + (0.4 - 0.1) / 1.0 + 0.3)    # the saw's way from the pre-cut
+    assert protocol_params(cases[0].params, half, static_cut=None)[0].saw.pre_cut == 0.0   # not critical: none
+    assert protocol_params(cases[0].params, half, static_cut=2.0)[0].saw.pre_cut == pytest.approx(0.2)  # half L
+    assert _case_id(cases[0], 0, half) != _case_id(cases[0], 0, FieldProtocol())
+    with pytest.raises(Exception, match="pre_cut_share = 1"):
+        FieldProtocol(pre_cut_share=1.0).validate()

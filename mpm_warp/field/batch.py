@@ -155,12 +155,24 @@ def run_records(run_dirs) -> list[tuple[dict, str]]:
     return out
 
 
+def _static_cut(case: FieldCase) -> float | None:
+    """weac's critical cut (m) of the case's column at its fracture energy; None when it is not critical or weac
+    is not installed."""
+    from ..scenes.pst.static import static_column
+    from ..scenes.weac_reference import critical_cut, weac_unavailable
+
+    if weac_unavailable() is not None:
+        return None
+    p = case.params
+    return critical_cut(static_column(p), p.weak_layer.w_f, max_cut=float(p.length))
+
+
 def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
     from ..scenes.pst import build
 
     tasks = []
     for k, c in enumerate(cases):
-        params, tc, note = protocol_params(c.params, proto)
+        params, tc, note = protocol_params(c.params, proto, _static_cut(c) if proto.pre_cut_share > 0.0 else None)
         if params is None:
             refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
             continue

@@ -43,6 +43,10 @@ class FieldProtocol:
         Time between frames (s): the outcome is checked at every frame.
     rigid_base : bool
         Run the weak layer on a rigid base (the default), or on the profile's old snow (False).
+    pre_cut_share : float
+        The saw's pre-cut (``scene.saw.pre_cut``) as a share of weac's critical cut of the column at its fracture
+        energy, in [0, 0.9]: the column starts sawn that far, sparing the simulated time of sawing it. 0 (the
+        default): the saw cuts from the end.
     threads : int
         CPU threads each case's step runs on (the CPU step's own threads; ignored on CUDA). A batch's workers
         times this should not exceed the cores: on 2 cores, 1 worker of 2 threads finishes each case sooner
@@ -55,6 +59,7 @@ class FieldProtocol:
     tail: float = 0.3
     frame_interval: float = 0.005
     rigid_base: bool = True
+    pre_cut_share: float = 0.0
     threads: int = 1
 
     def validate(self) -> FieldProtocol:
@@ -69,6 +74,7 @@ class FieldProtocol:
         positive_int("threads", self.threads, lo=1, hi=64)
         if not isinstance(self.rigid_base, bool):
             raise InvalidArgument("rigid_base", self.rigid_base, "true or false")
+        finite_number("pre_cut_share", self.pre_cut_share, lo=0.0, hi=0.9)
         return self
 
     def run_key(self) -> dict:
@@ -86,15 +92,22 @@ def particle_estimate(p: PSTParams) -> int:
     return int(math.ceil(p.length * height / spacing ** 2))
 
 
-def protocol_params(params: PSTParams, proto: FieldProtocol) -> tuple[PSTParams | None, TimeControl | None, str]:
-    """The field case ``params`` as the protocol runs it: ``(params, time, note)``, or ``(None, None, reason)``."""
+def protocol_params(params: PSTParams, proto: FieldProtocol, static_cut: float | None = None
+                    ) -> tuple[PSTParams | None, TimeControl | None, str]:
+    """The field case ``params`` as the protocol runs it: ``(params, time, note)``, or ``(None, None, reason)``.
+
+    ``static_cut`` is weac's critical cut of the column (m; None: not critical, or not asked for), the pre-cut's
+    measure when the protocol has one.
+    """
     if proto.rigid_base:
         bare = PSTParams()
         params = dataclasses.replace(params, rigid_base=True, substratum_layers=(), substratum=bare.substratum,
                                      substratum_thickness=bare.substratum_thickness)
     saw_fields = {f.name for f in dataclasses.fields(params.saw)}
+    pre = proto.pre_cut_share * static_cut if proto.pre_cut_share > 0.0 and static_cut else 0.0
     saw = dataclasses.replace(params.saw, cut_length=float(params.length), speed=proto.saw_speed,
-                              **({"stop": "runaway"} if "stop" in saw_fields else {}))
+                              **({"stop": "runaway"} if "stop" in saw_fields else {}),
+                              **({"pre_cut": min(pre, 0.5 * float(params.length))} if pre > 0.0 else {}))
     for cells in (proto.cells_across, 3):
         dx = params.weak_layer_thickness / cells
         p = dataclasses.replace(params, dx=dx, margin=max(params.margin, 2.0 * dx), saw=saw)
@@ -102,7 +115,8 @@ def protocol_params(params: PSTParams, proto: FieldProtocol) -> tuple[PSTParams 
         if n <= proto.max_particles:
             end = p.saw_start + (p.length - p.saw.pre_cut) / proto.saw_speed + proto.tail
             note = (f"{cells} cells across the weak layer, dx {dx * 1e3:.2f} mm, about {n:,} particles"
-                    + (", on a rigid base" if proto.rigid_base else ""))
+                    + (", on a rigid base" if proto.rigid_base else "")
+                    + (f", pre-cut {p.saw.pre_cut * 100:.1f} cm" if p.saw.pre_cut > 0.0 else ""))
             return p.validate("scene"), TimeControl(end=end, frame_interval=proto.frame_interval), note
     return None, None, (f"the column is too large for the per-case budget: {n:,} particles at the coarsest grid "
                         f"the weak layer allows (3 cells), above {proto.max_particles:,}")

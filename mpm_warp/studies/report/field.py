@@ -73,6 +73,7 @@ def _batch_command(d: dict, out: str = "") -> str:
             + (f" --limit {sel['limit']}" if sel.get("limit") else "")
             + (" --finished-only" if sel.get("finished_only") else "")
             + ("" if _rigid(sel) else " --elastic-substratum")
+            + (f" --pre-cut-share {share:g}" if (share := (sel.get("protocol") or {}).get("pre_cut_share")) else "")
             + (f" --out {out}" if out else ""))
 
 
