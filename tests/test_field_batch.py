@@ -152,3 +152,17 @@ def test_a_protocol_with_a_pre_cut_starts_each_column_sawn_a_share_of_weacs_crit
     assert _case_id(cases[0], 0, half) != _case_id(cases[0], 0, FieldProtocol())
     with pytest.raises(Exception, match="pre_cut_share = 1"):
         FieldProtocol(pre_cut_share=1.0).validate()
+
+
+def test_the_pre_cut_is_measured_on_weacs_critical_cut_of_the_column(tmp_path):
+    """The cut at which weac's energy release rate of the column reaches the case's fracture energy."""
+    from mpm_warp.field.batch import _static_cut
+    from mpm_warp.scenes.pst.static import static_column
+    from mpm_warp.scenes.weac_reference import energy_release_rate
+
+    table = tmp_path / "psts.csv"
+    table.write_text(TABLE)
+    cases, _ = gather([str(table)], calibrate=False)
+    a = _static_cut(cases[0])
+    assert 0.0 < a < 0.4
+    assert energy_release_rate(static_column(cases[0].params), a)[0] == pytest.approx(0.3, rel=0.02)   # w_f given

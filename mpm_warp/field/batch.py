@@ -164,7 +164,7 @@ def _static_cut(case: FieldCase) -> float | None:
     if weac_unavailable() is not None:
         return None
     p = case.params
-    return critical_cut(static_column(p), p.weak_layer.w_f, max_cut=float(p.length))
+    return critical_cut(static_column(p), p.weak_layer.w_f)
 
 
 def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
