@@ -33,6 +33,7 @@ import sys
 from . import (  # noqa: F401
     convergence,
     field,
+    field_pre_cut,
     field_rigid_base,
     field_slab,
     field_slab_fe,
