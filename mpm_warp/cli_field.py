@@ -59,6 +59,6 @@ def add_field(sub) -> None:
     p.add_argument("--elastic-substratum", action="store_true",
                    help="run the weak layer on the profile's old snow instead of a rigid base (weac's column)")
     p.add_argument("--pre-cut-share", type=float, default=FieldProtocol.pre_cut_share, metavar="SHARE",
-                   help="start each column sawn this share of weac's critical cut, in [0, 0.9] (default 0: none)")
+                   help="start each column sawn this share of weac's critical cut, in [0, 0.9] (default 0.5; 0: none)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_field)

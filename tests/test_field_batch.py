@@ -149,7 +149,8 @@ def test_a_protocol_with_a_pre_cut_starts_each_column_sawn_a_share_of_weacs_crit
     assert tc.end == pytest.approx(p.saw_start + (0.4 - 0.1) / 1.0 + 0.3)    # the saw's way from the pre-cut
     assert protocol_params(cases[0].params, half, static_cut=None)[0].saw.pre_cut == 0.0   # not critical: none
     assert protocol_params(cases[0].params, half, static_cut=2.0)[0].saw.pre_cut == pytest.approx(0.2)  # half L
-    assert _case_id(cases[0], 0, half) != _case_id(cases[0], 0, FieldProtocol())
+    assert half == FieldProtocol()                                          # the default
+    assert _case_id(cases[0], 0, half) != _case_id(cases[0], 0, FieldProtocol(pre_cut_share=0.0))
     with pytest.raises(Exception, match="pre_cut_share = 1"):
         FieldProtocol(pre_cut_share=1.0).validate()
 

@@ -69,7 +69,7 @@ def main(argv=None) -> int:
     p.add_argument("--elastic-substratum", action="store_true",
                    help="run the weak layer on the profile's old snow instead of a rigid base (weac's column)")
     p.add_argument("--pre-cut-share", type=float, default=FieldProtocol.pre_cut_share,
-                   help="start each column sawn this share of weac's critical cut (default 0: none)")
+                   help="start each column sawn this share of weac's critical cut (default 0.5; 0: none)")
     p.add_argument("--no-measured", action="store_true",
                    help="leave out the measured-density columns (a first, small sample: the stratified part only)")
     args = p.parse_args(argv)

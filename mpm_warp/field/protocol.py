@@ -6,6 +6,8 @@
 - **The grid** resolves the weak layer with 4 cells (the resolution the snow ladders call resolved) when the
   column then fits :attr:`FieldProtocol.max_particles`; else with 3, the fewest the model allows; else the
   case is refused in one line (the column is too large for the budget).
+- **The pre-cut**: each column starts sawn half of weac's critical cut at its fracture energy
+  (``pre_cut_share``), as a slow saw would leave it; the blade goes on from there.
 - **The base**: the weak layer lies on a rigid base (``scene.rigid_base``), the column that weac reads the
   fracture energy back with; the old snow under it is left out (docs/field.md, "The field protocol").
 - **The run** lasts the settling, the saw's way to the end, and :attr:`FieldProtocol.tail` after it, and stops
@@ -45,8 +47,8 @@ class FieldProtocol:
         Run the weak layer on a rigid base (the default), or on the profile's old snow (False).
     pre_cut_share : float
         The saw's pre-cut (``scene.saw.pre_cut``) as a share of weac's critical cut of the column at its fracture
-        energy, in [0, 0.9]: the column starts sawn that far, sparing the simulated time of sawing it. 0 (the
-        default): the saw cuts from the end.
+        energy, in [0, 0.9]: the column starts sawn that far, sparing the simulated time of sawing it (0.5, the
+        default: docs/field.md); 0: the saw cuts from the end.
     threads : int
         CPU threads each case's step runs on (the CPU step's own threads; ignored on CUDA). A batch's workers
         times this should not exceed the cores: on 2 cores, 1 worker of 2 threads finishes each case sooner
@@ -59,7 +61,7 @@ class FieldProtocol:
     tail: float = 0.3
     frame_interval: float = 0.005
     rigid_base: bool = True
-    pre_cut_share: float = 0.0
+    pre_cut_share: float = 0.5
     threads: int = 1
 
     def validate(self) -> FieldProtocol:
