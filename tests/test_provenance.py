@@ -104,8 +104,6 @@ KNOWN_DIRTY = {
     "convergence/results/error_vs_runtime_snow.json":
         "python benchmarks/convergence/error_vs_runtime_snow.py",            # both ladders, hours
     "perf/results/pst_scaling_cpu.json": "python benchmarks/perf/pst_scaling.py",
-    "snow/results/snow_critical_cut.json":
-        "python benchmarks/snow/critical_cut.py flat slope ladder_saw_half ladder_slope",   # hours
     "snow/results/snow_long_speed_trends.json": "python benchmarks/snow/long_speed_trends.py",   # hours
 }
 
