@@ -73,7 +73,7 @@ def _batch_command(d: dict, out: str = "") -> str:
             + (f" --limit {sel['limit']}" if sel.get("limit") else "")
             + (" --finished-only" if sel.get("finished_only") else "")
             + ("" if _rigid(sel) else " --elastic-substratum")
-            + (f" --pre-cut-share {share:g}" if (share := (sel.get("protocol") or {}).get("pre_cut_share")) else "")
+            + f" --pre-cut-share {(sel.get('protocol') or {}).get('pre_cut_share', 0.0):g}"
             + (f" --out {out}" if out else ""))
 
 
@@ -83,9 +83,12 @@ def _rigid(sel: dict) -> bool:
 
 
 def _base(sel: dict) -> str:
-    return ("The columns ran on a rigid base (the field protocol's)." if _rigid(sel) else
-            "The columns ran on the profile's old snow, as the field protocol did before the rigid base (the command "
-            "says `--elastic-substratum`).")
+    share = (sel.get("protocol") or {}).get("pre_cut_share")
+    pre = (f", each pre-cut {share:g} of weac's critical cut" if share else
+           ", sawn from the end (no pre-cut)" if _rigid(sel) else "")
+    return (f"The columns ran on a rigid base{pre}." if _rigid(sel) else
+            "The columns ran on the profile's old snow, sawn from the end, as the field protocol did before the "
+            "rigid base and the pre-cut (the command says so).")
 
 
 def _interval(iv) -> str:
