@@ -5,12 +5,8 @@ from __future__ import annotations
 from statistics import median
 
 from .core import section
-from .field_rigid_base import CUT_SHARE
+from .field_rigid_base import CUT_SHARE, _cut
 from .fmt import check_line, count, env_note, fx, spct, table
-
-
-def _cut(x) -> str:
-    return "-" if x is None else fx(x, 3)
 
 
 def _change(c: dict):
