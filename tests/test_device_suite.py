@@ -88,7 +88,7 @@ def test_throughput_rows(quick):
     assert all(r["particle_steps_per_s"] > 0 for r in warp.values())
     el = warp[(3, "elastic")]
     # free fall of the block from rest: symplectic Euler, to float32 rounding of y ~ 0.5
-    assert el["com_y"] == pytest.approx(expected_com_y(el["warmup"] + el["steps"]), abs=1e-6)
+    assert el["com_y"] == pytest.approx(expected_com_y(el["warmup"] + el["steps"], el["dt"]), abs=1e-6)
     pl = warp[(3, "plastic")]
     assert pl["return_kind_problems"] == [] and len(pl["return_kinds"]) == pl["steps"]
     assert min(k["yielded"] for k in pl["return_kinds"]) >= pb.MIN_YIELDED
@@ -106,3 +106,31 @@ def test_pst_ran(quick):
     p = quick[0]["parts"]["pst"]["result"]
     assert p["steps"] > 0 and p["n_particles"] > 0 and p["sim_time_s"] == pytest.approx(0.002, abs=1e-12)
     assert p["edge_hits"] == 0 and p["particle_steps_per_s"] > 0
+
+
+def test_elastic_block_step_stays_stable_at_device_sizes():
+    """The device sizes (2D 1M-16M particles, up to 4,000 cells per axis) keep the elastic block's step under
+    the engine's stability limit: the fixed 1e-4 s is 1.05 times that limit at 1,000 cells (the first CUDA run
+    of the suite was refused there), so the step becomes dx / c_p from 862 cells on; every CPU size keeps 1e-4 s."""
+    from mpm_warp.materials import Elastic
+    from mpm_warp.studies.blocks import (
+        ELASTIC_DT,
+        ELASTIC_E,
+        ELASTIC_NU,
+        ELASTIC_RHO,
+        block_scenario,
+        elastic_time_step,
+    )
+    from mpm_warp.time_step import STABLE_DT
+
+    c_p = Elastic(ELASTIC_E, ELASTIC_NU, ELASTIC_RHO).p_wave_speed
+    assert c_p == pytest.approx(11.6, abs=0.05)
+    for n_grid in (24, 64, 128, 512, 860):
+        assert elastic_time_step(n_grid) == ELASTIC_DT
+    for n_grid in (862, 1000, 2000, 4000):
+        dt = elastic_time_step(n_grid)
+        assert dt == pytest.approx(1.0 / n_grid / c_p, rel=1e-12)
+        assert dt <= STABLE_DT * (1.0 / n_grid) / c_p / 1.1
+        block_scenario(n_grid, dt=dt, dim=2).validate()   # accepted where the fixed 1e-4 s was refused
+    with pytest.raises(Exception, match="time.dt"):
+        block_scenario(1000, dim=2).validate()

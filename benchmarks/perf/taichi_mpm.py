@@ -29,7 +29,7 @@ import numpy as np
 from taichi_camclay import S_FLOOR, camclay_return_func
 
 from mpm_warp.studies import plastic_block as pb
-from mpm_warp.studies.blocks import ELASTIC_DT, ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, GRAVITY_Y
+from mpm_warp.studies.blocks import ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, GRAVITY_Y, elastic_time_step
 
 #: Width (in cells) of the slip boundary layer, Taichi style.
 BOUND = 3
@@ -77,7 +77,7 @@ def build(ti: Any, n_grid: int, dim: int, material: str) -> SimpleNamespace:
         pb.check_n_grid(n_grid)
         E, nu, rho, dt = pb.YOUNG_E, pb.POISSON_NU, pb.DENSITY, pb.time_step(n_grid)
     else:
-        E, nu, rho, dt = ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, ELASTIC_DT
+        E, nu, rho, dt = ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, elastic_time_step(n_grid)
     p_vol = (0.5 * dx) ** dim  # 2D: per metre of thickness
     p_mass = rho * p_vol
     mu = E / (2.0 * (1.0 + nu))

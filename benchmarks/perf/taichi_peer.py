@@ -168,7 +168,7 @@ def run_taichi_block(n_grid: int, steps: int, arch: str = "cpu", cpu_max_num_thr
     else:
         com_y = float(f.x.to_numpy()[:, 1].astype("float64").mean())
         result["com_y_after"] = com_y
-        result["com_y_expected"] = expected_com_y(W + steps)
+        result["com_y_expected"] = expected_com_y(W + steps, scene.dt)
         finite = math.isfinite(com_y)
     result["cpu_s_per_step"] = statistics.median(cpu_times) / steps
     if return_share and plastic:

@@ -9,7 +9,7 @@ Usage::
 ``--particles`` are approximate counts: each becomes the even ``n_grid`` with
 ``n_grid**dim`` closest to it (2 particles per cell and axis in a unit box).
 The elastic block is ``mpm_warp.studies.blocks.block_scenario`` (E = 1e5 Pa, rho = 1000, dt =
-1e-4 s, free fall); the plastic block is the struck Cam-Clay snow of
+1e-4 s, or dx / c_p on grids finer than 1.16 mm; free fall); the plastic block is the struck Cam-Clay snow of
 ``mpm_warp.studies.plastic_block``. Both engines follow the protocol of ``warp_block`` /
 ``taichi_peer`` (compiled, warmed up, median of three repeats from one
 snapshot; Taichi in its own process per configuration). On the CPU each row

@@ -2,9 +2,10 @@
 
 The elastic block: a unit box (square in 2D) with slip faces three cells in from the grid edge, the
 block ``[0.25, 0.75]^dim`` with 2 particles per cell and axis (``n_grid^dim`` particles), Hencky
-elastic E = 1e5 Pa, nu = 0.3, rho = 1000 kg/m^3, gravity along -y, fixed dt = 1e-4 s, in free
-fall from rest. The plastic block: the same lattice of the struck Cam-Clay snow of
-:mod:`.plastic_block`. ``dim = 2`` is plane strain (per metre of depth).
+elastic E = 1e5 Pa, nu = 0.3, rho = 1000 kg/m^3, gravity along -y, in free fall from rest, with
+the fixed step :func:`elastic_time_step` (1e-4 s, or one cell per step at the P-wave speed on grids
+finer than 1.16 mm, where 1e-4 s would exceed the engine's stability limit). The plastic block: the same lattice of
+the struck Cam-Clay snow of :mod:`.plastic_block`. ``dim = 2`` is plane strain (per metre of depth).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from ..materials import CamClaySnow, Elastic
 from ..simulation import Simulation
 from . import plastic_block as pb
 
-__all__ = ["ELASTIC_E", "ELASTIC_NU", "ELASTIC_RHO", "ELASTIC_DT", "GRAVITY_Y", "block_scenario",
+__all__ = ["ELASTIC_E", "ELASTIC_NU", "ELASTIC_RHO", "ELASTIC_DT", "GRAVITY_Y", "elastic_time_step", "block_scenario",
            "plastic_material", "block_simulation", "default_warmup", "expected_com_y", "block_positions",
            "initial_state"]
 
@@ -26,6 +27,17 @@ __all__ = ["ELASTIC_E", "ELASTIC_NU", "ELASTIC_RHO", "ELASTIC_DT", "GRAVITY_Y", 
 ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, ELASTIC_DT = 1.0e5, 0.3, 1000.0, 1.0e-4
 #: Gravity along y (m/s^2), both blocks.
 GRAVITY_Y = pb.GRAVITY_Y
+
+
+def elastic_time_step(n_grid: int) -> float:
+    """Fixed step (s) of the elastic block on ``n_grid`` cells: ``min(ELASTIC_DT, dx / c_p)``.
+
+    ``dx / c_p`` (one cell per step at the P-wave speed, 11.6 m/s) lies under the engine's stability
+    limit 1.11 dx / c_p (:data:`mpm_warp.time_step.STABLE_DT`); it is smaller than 1e-4 s from ``n_grid``
+    = 862 on, so every CPU size (at most 512 cells per axis) keeps 1e-4 s.
+    """
+    c_p = Elastic(ELASTIC_E, ELASTIC_NU, ELASTIC_RHO).p_wave_speed
+    return min(ELASTIC_DT, (1.0 / n_grid) / c_p)
 
 
 def block_scenario(n_grid: int, material=None, boundary: str = "slip", precision: str = "float32",
@@ -71,7 +83,8 @@ def block_simulation(dim: int, material: str, n_grid: int, device: str = "cpu", 
     if dim not in (2, 3):
         raise ValueError(f"dim must be 2 or 3, got {dim}")
     if material == "elastic":
-        return Simulation(block_scenario(n_grid, dim=dim), device=device, n_threads=n_threads)
+        return Simulation(block_scenario(n_grid, dt=elastic_time_step(n_grid), dim=dim), device=device,
+                          n_threads=n_threads)
     if material != "plastic":
         raise ValueError(f"material must be 'elastic' or 'plastic', got {material!r}")
     pb.check_n_grid(n_grid)
