@@ -53,6 +53,7 @@ import sys
 import tempfile
 import time
 import xml.etree.ElementTree as ET
+from concurrent.futures import ThreadPoolExecutor
 
 # mpm_warp is imported inside the parts: the graph_deterministic part sets Warp's deterministic atomics first
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -90,53 +91,35 @@ def _tag(device: str, quick: bool) -> str:
 def part_tests(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
     """Run the device-parametrised test modules on ``device``, one pytest per module, within the budget.
 
-    The modules run side by side, :data:`TEST_WORKERS` at a time: on a fresh machine most of a module's time is
-    compiling its kernels, which is CPU work (one after another, the first CUDA run reached 4 of 18 modules
-    in 120 s). Every module still runs alone in its own interpreter, its kernels on the one device.
+    :data:`TEST_WORKERS` modules at a time, each in its own interpreter: on a fresh machine a module's time is mostly
+    compiling kernels, CPU work (one by one, the first CUDA run reached 4 of 18 modules in 120 s).
     """
     groups = [(m, False) for m in (QUICK_TEST_MODULES if quick else TEST_MODULES)]
     if not quick:
         groups += [(m, _is_cuda(device)) for m in BITWISE_TEST_MODULES]
-    modules = {m: {"status": "not_run", "reason": "part budget spent"} for m, _ in groups}
+
+    def run_module(module: str, deterministic: bool, tmp: str) -> dict:
+        left = deadline - time.time()
+        if left < 5:
+            return {"status": "not_run", "reason": "part budget spent"}
+        env = dict(os.environ, MPM_WARP_TEST_DEVICE=device, MPM_WARP_TEST_DETERMINISTIC="1" if deterministic else "0")
+        xml = os.path.join(tmp, module + ".xml")
+        cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", f"--junitxml={xml}",
+               os.path.join(ROOT, "tests", module + ".py")]
+        t0 = time.time()
+        rc, tail = _run_group(cmd, left - 2, env, cwd=ROOT)
+        rec = {"seconds": time.time() - t0, "deterministic_atomics": deterministic, "exit_code": rc}
+        if rc is None:
+            return {**rec, "status": "timed_out", "output_tail": tail}
+        if not os.path.exists(xml):
+            return {**rec, "status": "error", "output_tail": tail}
+        rec.update(_junit_counts(xml), status="passed" if rc == 0 else "failed")
+        return {**rec, "output_tail": tail} if rc != 0 else rec
+
     workers = max(1, min(TEST_WORKERS, os.cpu_count() or 1, len(groups)))
-    with tempfile.TemporaryDirectory() as tmp, contextlib.ExitStack() as stack:
-        pending, running = list(groups), {}
-        while pending or running:
-            while pending and len(running) < workers and deadline - time.time() > 5:
-                module, deterministic = pending.pop(0)
-                env = dict(os.environ, MPM_WARP_TEST_DEVICE=device,
-                           MPM_WARP_TEST_DETERMINISTIC="1" if deterministic else "0")
-                xml = os.path.join(tmp, module + ".xml")
-                log = stack.enter_context(tempfile.TemporaryFile(mode="w+"))
-                cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", f"--junitxml={xml}",
-                       os.path.join(ROOT, "tests", module + ".py")]
-                proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env, cwd=ROOT,
-                                        start_new_session=True)
-                running[module] = (proc, log, xml, deterministic, time.time())
-            if not running:
-                break
-            time.sleep(0.2)
-            for module, (proc, log, xml, deterministic, t0) in list(running.items()):
-                rc = proc.poll()
-                if rc is None and time.time() < deadline - 2:
-                    continue
-                if rc is None:
-                    os.killpg(proc.pid, signal.SIGKILL)
-                    proc.wait()
-                log.seek(0)
-                tail = log.read()[-4000:]
-                rec = {"seconds": time.time() - t0, "deterministic_atomics": deterministic, "exit_code": rc}
-                if rc is None:
-                    rec.update(status="timed_out", output_tail=tail)
-                elif os.path.exists(xml):
-                    rec.update(_junit_counts(xml))
-                    rec["status"] = "passed" if rc == 0 else "failed"
-                    if rc != 0:
-                        rec["output_tail"] = tail
-                else:
-                    rec.update(status="error", output_tail=tail)
-                modules[module] = rec
-                del running[module]
+    with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(workers) as pool:
+        futures = {m: pool.submit(run_module, m, det, tmp) for m, det in groups}
+        modules = {m: f.result() for m, f in futures.items()}
     counts = {k: sum(m.get(k, 0) for m in modules.values()) for k in ("tests", "failures", "errors", "skipped")}
     return {"device": device, "workers": workers, "modules": modules, **counts,
             "all_passed": all(m.get("status") == "passed" for m in modules.values())}
