@@ -39,6 +39,7 @@ from . import (  # noqa: F401
     field_slab_fe,
     main_job,
     perf,
+    perf_cuda,
     robustness,
     scaling,
     snow_runs,

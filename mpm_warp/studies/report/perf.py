@@ -249,8 +249,6 @@ def render_eig3(data: dict, ctx) -> list[str]:
                   "orthogonality."]
 
 
-pending("perf", "CUDA: the device suite", "perf/results/device_suite_cuda.json", "bash benchmarks/device_suite.sh",
-        question="Does everything hold on a GPU: device tests, graph against eager, throughput, memory, a PST?")
 @section("perf", "CUDA: every kernel compiled to PTX", "perf/results/cuda_ptx.json",
          "python tests/helpers_cuda_compile.py --work /tmp/ptx --record benchmarks/perf/results/cuda_ptx.json",
          question="Do the kernels of the ready scenes compile for CUDA without a GPU?")
