@@ -65,6 +65,7 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     stamp = os.stat(done).st_mtime_ns
     again = run_field([str(table)], out, workers=1, progress=False, protocol=FieldProtocol(threads=2))
     assert [r["threads"] for r in again.records] == [1, 2]     # what each case's step ran on
+    assert [r["workers"] for r in again.records] == [1, 1]     # and how many cases ran side by side
     assert again.skipped == 1 and len(again.records) == 2 and os.stat(done).st_mtime_ns == stamp
     assert all(r["status"] == "ok" for r in again.records)
     assert [r["observed"] for r in again.records] == ["END", "ARR"]
@@ -74,6 +75,8 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
         sc = json.load(fh)
     assert sc["cases"] == 2 and set(sc) >= {"model", "majority", "weac_static", "wall_s"}
     assert sc == json.loads(json.dumps(score_records(again.records)))
+    assert [(g["threads"], g["workers"], g["cases"]) for g in sc["wall_s_by_config"]] == [(1, 1, 1), (2, 1, 1)]
+    assert sc["wall_s_by_config"][1]["median"] == again.records[1]["wall_s"]
     with open(os.path.join(out, "refused.csv")) as fh:
         assert "slope_deg is empty" in fh.read()
     assert os.path.getsize(os.path.join(out, "confusion.png")) > 0

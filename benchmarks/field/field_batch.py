@@ -104,8 +104,8 @@ def main(argv=None) -> int:
             "refused_at_build": None if args.finished_only else [r.line() for r in batch.refused],
             "resumed_cases": batch.skipped, "runs": runs,
             "cases": [{k: r.get(k) for k in ("id", "test", "observed", "predicted", "static_class", "recorded_cut",
-                                             "runaway_cut", "w_f", "w_f_source", "particles", "steps", "wall_s",
-                                             "status", "error")} for r in batch.records]}
+                                             "runaway_cut", "w_f", "w_f_source", "particles", "steps", "threads",
+                                             "workers", "wall_s", "status", "error")} for r in batch.records]}
     path = write_json("field_batch", data, out_dir(args, RESULTS, "field_batch"))
     sc = batch.scores
     print(f"{path}: {sc['cases']} cases, balanced accuracy model {sc['model']['balanced_accuracy']}, majority "

@@ -118,7 +118,7 @@ def run_case(task: dict) -> dict:
                    runaway_cut=_finite(res.scene_result.get("runaway_cut")),
                    slab_fracture_at=_finite(o.get("slab_fracture_at")), note=o.get("note", ""),
                    sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
-                   threads=used.get("threads"),
+                   threads=used.get("threads"), workers=task.get("workers"),
                    n_frames=io.read_run(out + ".part.h5").n_frames)
         io.promote_part(out)
         rec["run_file"] = os.path.basename(out + ".h5")
@@ -201,6 +201,8 @@ def _execute(todo, records, workers, scheduler, stream, total, threads=1) -> Non
                 n_workers=workers or max(1, (os.cpu_count() or 1) // threads), threads_per_worker=1, processes=True,
                 dashboard_address=None, silence_logs=40, env={"MPM_WARP_THREADS": str(threads)}))
             client = stack.enter_context(Client(cluster))
+        n_workers = len(client.scheduler_info().get("workers", {})) or None
+        todo = [{**t, "workers": n_workers} for t in todo]    # each record says how many cases ran beside it
         token, t0, done = uuid.uuid4().hex[:8], time.perf_counter(), 0
         futures = {client.submit(run_case, t, key=f"{t['id']}-{token}", retries=1, pure=False, priority=-i): t
                    for i, t in enumerate(todo)}
@@ -282,8 +284,8 @@ def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None =
 
 #: the columns of cases.csv
 CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "static_class", "recorded_cut", "runaway_cut",
-                "slab_fracture_at", "w_f", "w_f_source", "setup", "particles", "steps", "threads", "wall_s", "run_file",
-                "error")
+                "slab_fracture_at", "w_f", "w_f_source", "setup", "particles", "steps", "threads", "workers", "wall_s",
+                "run_file", "error")
 
 
 def _write_outputs(out_dir: str, recs: list, refused: list) -> None:
@@ -307,4 +309,15 @@ def score_records(recs: list) -> dict:
             **{name: scores(obs, p) for name, p in pred.items()},
             "uncertainty": balanced_accuracy_intervals(obs, pred, reference="model"),
             "wall_s": {"median": statistics.median(walls) if (walls := [r["wall_s"] for r in ok]) else None,
-                       "total": sum(r["wall_s"] for r in ok)}}
+                       "total": sum(r["wall_s"] for r in ok)},
+            "wall_s_by_config": wall_by_config(ok)}
+
+
+def wall_by_config(recs: list) -> list[dict]:
+    """The median wall time (s) of the cases by how they ran: threads per case and Dask workers side by side
+    (None where a record from before this was kept does not say)."""
+    groups = {}
+    for r in recs:
+        groups.setdefault((r.get("threads"), r.get("workers")), []).append(r["wall_s"])
+    return [{"threads": t, "workers": w, "cases": len(v), "median": statistics.median(v)}
+            for (t, w), v in sorted(groups.items(), key=lambda kv: (kv[0][0] or 0, kv[0][1] or 0))]

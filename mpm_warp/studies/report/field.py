@@ -119,6 +119,22 @@ def _verdict(sc: dict, m, best: float) -> str:
     return "pass" if m is not None and m > best else "fail"
 
 
+def _case_median(sc: dict) -> tuple[float | None, str, str]:
+    """The median case's wall time the check reads, what it is over, and the medians of the other configurations.
+
+    Where some cases ran one at a time on 2 threads (one worker: the case had both cores), the check reads theirs;
+    otherwise the median over all cases."""
+    groups = sc.get("wall_s_by_config") or []
+    both = [g for g in groups if g["threads"] == 2 and g["workers"] == 1]
+    if not both or len(groups) < 2:
+        return sc["wall_s"]["median"], "", ""
+    rest = "; ".join(f"{count(g['cases'])} cases on {_threads(g['threads'] or 1)} each, "
+                     f"{_workers(g['workers']) if g['workers'] else 'workers not recorded'}: median {secs(g['median'])}"
+                     for g in groups if g not in both)
+    return (both[0]["median"], f", one case at a time on 2 threads ({count(both[0]['cases'])} cases)",
+            f" (the others: {rest})")
+
+
 def _threads(n: int) -> str:
     return "one thread" if n == 1 else f"{n} threads"
 
@@ -168,13 +184,13 @@ def render_batch(data: dict, ctx) -> list[str]:
                                                                                           conf["counts"], strict=True)])
     m, best = sc["model"]["balanced_accuracy"], max(sc["majority"]["balanced_accuracy"] or 0.0,
                                                     sc["weac_static"]["balanced_accuracy"] or 0.0)
-    med = sc["wall_s"]["median"]
+    med, alone, by_config = _case_median(sc)
     out += ["", f"**Check:** the model's balanced accuracy above both baselines': {_ba(sc['model'])} against "
             f"{best:.2f}, **{_verdict(sc, m, best)}**"
             + (" (too few cases to tell: at least 50 per class are needed; a balanced accuracy is over the observed "
                "classes present)" if sc["cases"] < 150 else "") + "." + _differences(unc), "",
-            f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time: {secs(med)}, "
-            f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** (particle budget "
+            f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time{alone}: {secs(med)}, "
+            f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}**{by_config} (particle budget "
             f"{count(sel['max_particles'])}, {_threads(data.get('threads_per_case', 1))} per case, "
             f"{_workers(data.get('workers'))}; "
             + (f"{fx(data['cases_per_hour'], 0)} cases per hour)." if data.get("cases_per_hour") else
