@@ -103,7 +103,6 @@ def test_a_full_run_from_a_dirty_tree_is_refused_before_it_starts(monkeypatch, t
 KNOWN_DIRTY = {
     "convergence/results/error_vs_runtime_snow.json":
         "python benchmarks/convergence/error_vs_runtime_snow.py",            # both ladders, hours
-    "perf/results/pst_scaling_cpu.json": "python benchmarks/perf/pst_scaling.py",
     "snow/results/snow_long_speed_trends.json": "python benchmarks/snow/long_speed_trends.py",   # hours
 }
 
