@@ -128,11 +128,11 @@ def _case_median(sc: dict) -> tuple[float | None, str, str]:
     both = [g for g in groups if g["threads"] == 2 and g["workers"] == 1]
     if not both or len(groups) < 2:
         return sc["wall_s"]["median"], "", ""
-    rest = "; ".join(f"{count(g['cases'])} cases on {_threads(g['threads'] or 1)} each, "
-                     f"{_workers(g['workers']) if g['workers'] else 'workers not recorded'}: median {secs(g['median'])}"
-                     for g in groups if g not in both)
+    rest = "; ".join(f"{count(g['cases'])} case{'s' if g['cases'] != 1 else ''} on {_threads(g['threads'] or 1)}"
+                     f" each, {_workers(g['workers']) if g['workers'] else 'workers not recorded'}: median "
+                     f"{secs(g['median'])}" for g in groups if g not in both)
     return (both[0]["median"], f", one case at a time on 2 threads ({count(both[0]['cases'])} cases)",
-            f" (the others: {rest})")
+            f"the others: {rest}; ")
 
 
 def _threads(n: int) -> str:
@@ -190,7 +190,7 @@ def render_batch(data: dict, ctx) -> list[str]:
             + (" (too few cases to tell: at least 50 per class are needed; a balanced accuracy is over the observed "
                "classes present)" if sc["cases"] < 150 else "") + "." + _differences(unc), "",
             f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time{alone}: {secs(med)}, "
-            f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}**{by_config} (particle budget "
+            f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** ({by_config}particle budget "
             f"{count(sel['max_particles'])}, {_threads(data.get('threads_per_case', 1))} per case, "
             f"{_workers(data.get('workers'))}; "
             + (f"{fx(data['cases_per_hour'], 0)} cases per hour)." if data.get("cases_per_hour") else
@@ -198,10 +198,13 @@ def render_batch(data: dict, ctx) -> list[str]:
                "stopped and resumed), which this one found finished and scored: the batch's rate is not measured "
                "here; each case's wall time is its own run's, on this shared machine).")]
     ran = [c for c in data.get("cases", []) if c.get("status") == "ok" and c.get("particles") and c.get("steps")]
+    if alone:   # the cost of the cases the check reads
+        ran = [c for c in ran if c.get("threads") == 2 and c.get("workers") == 1]
     if ran:
         work = median([c["particles"] * c["steps"] for c in ran])
         ns = median([c["wall_s"] / (c["particles"] * c["steps"]) * 1e9 for c in ran])
-        out += ["", f"- **Cost:** medians over the cases: {count(median([c['particles'] for c in ran]))} particles, "
+        over = "the cases" + (" run one at a time on 2 threads" if alone else "")
+        out += ["", f"- **Cost:** medians over {over}: {count(median([c['particles'] for c in ran]))} particles, "
                 f"{count(median([c['steps'] for c in ran]))} steps, {fx(work / 1e9, 2)} G particle-steps (particles "
                 f"times steps), {fx(ns, 0)} ns of wall time a particle-step. {CASE_BUDGET_S:g} s at that rate is "
                 f"{fx(CASE_BUDGET_S / ns, 2)} G particle-steps: the median case's work is "
