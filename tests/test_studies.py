@@ -12,6 +12,7 @@ import pytest
 from mpm_warp.errors import InvalidArgument
 from mpm_warp.finite_json import load_json
 from mpm_warp.studies.convergence import (
+    errors_against_reference,
     ladder_summary,
     loglog_slope,
     observed_order,
@@ -21,7 +22,7 @@ from mpm_warp.studies.convergence import (
 )
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser, result_name
-from mpm_warp.studies.snow import grid_bracket, merge_pst_parts
+from mpm_warp.studies.snow import field_level_dx, grid_bracket, merge_pst_parts
 
 CONVERGENCE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks", "convergence",
                            "results")
@@ -102,6 +103,26 @@ def test_ladder_summary_reproduces_the_committed_snow_ladders():
     speed = data["summary"]["pst"]["speed"]
     assert speed["richardson"] == pytest.approx(22.41, abs=0.01)
     assert speed["observed_order"] == pytest.approx(1.69, abs=0.01)
+
+
+def test_a_level_off_the_ladder_is_measured_against_the_ladders_own_reference():
+    """The field protocol's level (4 cells across the ladder's 6 cm layer: dx 15 mm) against the committed PST
+    ladder: the crack speed against its Richardson value (22.41 m/s), the touchdown against the finest level's
+    (0.7413 m); a missing value has no error; the critical cut's bisection bracket gives its half width."""
+    assert field_level_dx() == pytest.approx(0.015, rel=1e-15)
+    data = load_json(os.path.join(CONVERGENCE, "error_vs_runtime_snow.json"))
+    summ = data["summary"]["pst"]
+    rec = {"speed": 20.0, "touchdown": 0.70, "collapse_height": math.nan, "critical_cut": 0.353125,
+           "critical_cut_bracket": [0.34375, 0.3625]}
+    got = errors_against_reference(rec, summ, ("critical_cut", "speed", "touchdown", "collapse_height"))
+    assert got["speed"]["reference_is"] == "richardson"
+    assert got["speed"]["error"] == pytest.approx(1.0 - 20.0 / summ["speed"]["richardson"], rel=1e-12)
+    assert got["speed"]["error"] == pytest.approx(0.1075, abs=1e-4)
+    assert got["touchdown"]["reference_is"] == "finest level"
+    assert got["touchdown"]["error"] == pytest.approx(1.0 - 0.70 / 0.7413022939415157, rel=1e-12)
+    assert math.isnan(got["collapse_height"]["error"])
+    assert got["critical_cut"]["error"] == pytest.approx(0.353125 / 0.334375 - 1.0, rel=1e-12)   # 5.6 %
+    assert got["critical_cut"]["half_width"] == pytest.approx(0.5 * 0.01875 / 0.353125, rel=1e-12)
 
 
 def test_observed_orders_of_the_committed_reference_problems():

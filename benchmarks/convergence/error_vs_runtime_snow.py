@@ -22,6 +22,11 @@ three finest where the observed order allows it (0.5 <= p <= 4, monotone), each 
 5 % and to 1 % error (log-log interpolation along the ladder, or "not reached"). One level is also run
 in float64 (``--precision-level``) to say whether float32 limits a quantity.
 
+``--field-level`` runs the ladder PST once more at the field protocol's resolution, off the halving ladder:
+``mpm_warp.field.protocol.FieldProtocol.cells_across`` cells across the layer (4: dx 15 mm), the same
+bisection and base run as every level. Its error is stated against the PST ladder's reference
+(``field_level`` in the JSON); the field batch's cost check quotes it (docs/field.md).
+
 The ladder PST, its levels and bisection grid are :mod:`mpm_warp.studies.snow`; the errors, orders
 and times :mod:`mpm_warp.studies.convergence`.
 
@@ -37,6 +42,7 @@ Usage (hours on 2 CPU cores; the finest PST level dominates)::
     .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 --device cuda:0  # GPU
     .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 --base-only \
         --workdir runs/   # the 24-cell base run on the CPU, over several sessions (rerun to resume)
+    .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --field-level   # the 4-cell PST (minutes)
     .venv/bin/python benchmarks/convergence/error_vs_runtime_snow.py --ladder pst --levels 3 \
         --pst-bracket 0.30625 0.34375 --workers 2 --threads 2
         # its critical cut, bisected where the coarser levels put it (one trial each side)
@@ -60,10 +66,19 @@ from mpm_warp.errors import InvalidArgument
 from mpm_warp.finite_json import load_json
 from mpm_warp.memory import estimate_memory
 from mpm_warp.scenes.pst import critical_cut
-from mpm_warp.studies.convergence import ladder_summary
+from mpm_warp.studies.convergence import errors_against_reference, ladder_summary
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
-from mpm_warp.studies.snow import PST_BRACKET, PST_DX, SHEAR_CELLS, grid_bracket, ladder_pst, merge_pst_parts, pst_part
+from mpm_warp.studies.snow import (
+    PST_BRACKET,
+    PST_DX,
+    SHEAR_CELLS,
+    field_level_dx,
+    grid_bracket,
+    ladder_pst,
+    merge_pst_parts,
+    pst_part,
+)
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 OUT = "error_vs_runtime_snow"
@@ -287,6 +302,9 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=1, choices=(1, 2),
                     help="PST critical cut: 2 runs the trials of the bracket's bottom and first midpoint at once")
     ap.add_argument("--threads", type=int, default=None, help="CPU threads of each simulation")
+    ap.add_argument("--field-level", action="store_true",
+                    help="only the PST at the field protocol's cells across the layer (off the halving ladder), "
+                         "its error against the PST ladder's reference")
     a = ap.parse_args(argv)
     if a.quick:
         a.ladder, a.levels, a.precision_level = "shear", [0], -1
@@ -300,6 +318,8 @@ def main(argv=None) -> int:
     data = load(a.results, name)
     data["environment"] = environment(a.device)
     commit = data["environment"].get("git_commit")   # the code this process runs (it may change while it runs)
+    if a.field_level:
+        return run_field_level(a, name)
     ladders = ["shear", "pst"] if a.ladder == "both" else [a.ladder]
     for ladder in ladders:
         n = len(PST_DX if ladder == "pst" else SHEAR_CELLS)
@@ -339,9 +359,33 @@ def main(argv=None) -> int:
             have[:] = [x for x in have if not (x.get("level") == i and x["precision"] == prec)] + [rec]
             have.sort(key=lambda x: (x["precision"], x["level"]))
             data["summary"] = {k: summarise(k, v) for k, v in data["ladders"].items()}
+            if data.get("field_level"):            # its error follows the ladder's reference
+                data["field_level"]["errors"] = errors_against_reference(data["field_level"]["record"],
+                                                                   data["summary"].get("pst", {}), QUANTITIES["pst"])
             write_json(name, data, a.results)
             figure(data, os.path.join(a.results, name + ".png"))
             print(json.dumps({k: rec[k] for k in rec if k in (*QUANTITIES[ladder], "wall_time_s")}), flush=True)
+    print("results in", a.results, flush=True)
+    return 0
+
+
+def run_field_level(a, name: str) -> int:
+    """``--field-level``: the ladder PST at the field protocol's resolution, merged into the JSON as ``field_level``."""
+    data = load(a.results, name)
+    if data.get("field_level") and not a.redo:
+        print("the field level is in the JSON already (--redo runs it again)", flush=True)
+        return 0
+    dx = field_level_dx()
+    print(f"pst field level: dx {dx:g} m", flush=True)
+    rec = pst_level(dx, "float32", dict(PST_BRACKET), a.device, a.workers, a.threads)
+    rec["device"] = a.device
+    rec["git_commit"] = environment(a.device).get("git_commit")
+    data = load(a.results, name)
+    data["environment_field_level"] = environment(a.device)
+    errors = errors_against_reference(rec, data.get("summary", {}).get("pst", {}), QUANTITIES["pst"])
+    data["field_level"] = {"record": rec, "errors": errors}
+    write_json(name, data, a.results)
+    print(json.dumps({q: e["error"] for q, e in data["field_level"]["errors"].items()}), flush=True)
     print("results in", a.results, flush=True)
     return 0
 

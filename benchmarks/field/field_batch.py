@@ -36,6 +36,11 @@ def all_measured(case) -> bool:
     return all(p.measured for p in case.column.slab)
 
 
+#: each case's keys in the JSON
+CASE_KEYS = ("id", "test", "observed", "predicted", "static_class", "recorded_cut", "runaway_cut", "w_f", "w_f_source",
+             "setup", "particles", "steps", "threads", "workers", "wall_s", "status", "error")
+
+
 def select(cases, per_class: int, seed: int, measured: bool = True) -> tuple[list, dict]:
     """The measured-density columns (when ``measured``) and a seeded sample of ``per_class`` per observed class."""
     chosen = [c for c in cases if measured and all_measured(c)]
@@ -103,9 +108,7 @@ def main(argv=None) -> int:
             "cases_per_hour": 3600.0 * len(ok) / wall if wall > 0 and batch.skipped == 0 else None,
             "refused_at_build": None if args.finished_only else [r.line() for r in batch.refused],
             "resumed_cases": batch.skipped, "runs": runs,
-            "cases": [{k: r.get(k) for k in ("id", "test", "observed", "predicted", "static_class", "recorded_cut",
-                                             "runaway_cut", "w_f", "w_f_source", "particles", "steps", "threads",
-                                             "workers", "wall_s", "status", "error")} for r in batch.records]}
+            "cases": [{k: r.get(k) for k in CASE_KEYS} for r in batch.records]}
     path = write_json("field_batch", data, out_dir(args, RESULTS, "field_batch"))
     sc = batch.scores
     print(f"{path}: {sc['cases']} cases, balanced accuracy model {sc['model']['balanced_accuracy']}, majority "

@@ -138,3 +138,30 @@ def ladder_summary(levels: list[dict], quantities, targets=(0.05, 0.01)) -> dict
                   "time_to": {f"{round(100 * t)}%": time_to(list(use), walls[:len(v)], t) for t in targets},
                   "reference_used_for_time_to": "richardson" if np.isfinite(rich) else "finest level"}
     return out
+
+
+def errors_against_reference(rec: dict, summary: dict, quantities) -> dict:
+    """A level off the ladder (e.g. the field protocol's resolution) against the ladder's reference.
+
+    The reference of each quantity is the one the ladder's ``time_to`` uses (:func:`ladder_summary`): the
+    Richardson value where it exists, else the finest level's value. Returns per quantity ``value``,
+    ``reference``, ``reference_is`` ("richardson" or "finest level") and ``error`` (relative; nan where a value
+    is missing); where ``rec`` has a ``<quantity>_bracket`` (a bisection), also its ``half_width`` (relative):
+    an error below the brackets' half widths is not resolved.
+    """
+    out = {}
+    for q in quantities:
+        s = summary.get(q)
+        if not s:
+            continue
+        rich = s.get("richardson")
+        use_r = s.get("reference_used_for_time_to") == "richardson" and rich is not None and math.isfinite(rich)
+        ref = rich if use_r else s["values"][-1]
+        v = rec.get(q)
+        ok = v is not None and math.isfinite(v) and ref is not None and math.isfinite(ref) and ref != 0
+        out[q] = {"value": v, "reference": ref, "reference_is": "richardson" if use_r else "finest level",
+                  "error": abs(v / ref - 1.0) if ok else math.nan}
+        if ok and rec.get(q + "_bracket"):
+            lo, hi = rec[q + "_bracket"]
+            out[q]["half_width"] = 0.5 * (hi - lo) / v
+    return out

@@ -11,12 +11,15 @@ from __future__ import annotations
 
 from ..errors import InvalidArgument
 
-__all__ = ["LADDER_PST", "PST_DX", "PST_BRACKET", "SHEAR_CELLS", "FIELD_SPEED", "LONG_PST_SPEED", "DEM_STEADY_MAX",
+__all__ = ["LADDER_PST", "LADDER_WEAK_LAYER",
+           "PST_DX", "PST_BRACKET", "SHEAR_CELLS", "FIELD_SPEED", "LONG_PST_SPEED", "DEM_STEADY_MAX",
            "SUPERSHEAR_MAX", "STEADY_FROM", "FIELD_CUT",
-           "PST_CUT_FIELDS", "ladder_pst", "grid_bracket", "pst_part", "merge_pst_parts"]
+           "PST_CUT_FIELDS", "ladder_pst", "field_level_dx", "grid_bracket", "pst_part", "merge_pst_parts"]
 
+#: The ladder PST's weak layer (m).
+LADDER_WEAK_LAYER = 0.06
 #: Scenario overrides of ``pst_flat`` that make the ladder PST (module docstring).
-LADDER_PST = ("scene.length=2.2", "scene.slab_thickness=0.3", "scene.weak_layer_thickness=0.06",
+LADDER_PST = ("scene.length=2.2", "scene.slab_thickness=0.3", f"scene.weak_layer_thickness={LADDER_WEAK_LAYER!r}",
               "scene.substratum_thickness=0.06", "scene.margin=0.05")
 #: The PST ladder's grid spacings (m): 3, 6, 12, 24 cells across the 6 cm layer.
 PST_DX = (0.02, 0.01, 0.005, 0.0025)
@@ -44,6 +47,14 @@ PST_CUT_FIELDS = ("critical_cut", "critical_cut_bracket", "bracketed", "critical
 def ladder_pst(dx: float | None = 0.01) -> list[str]:
     """Overrides of ``pst_flat`` for the ladder PST at grid spacing ``dx`` (m; None: the scenario's own)."""
     return list(LADDER_PST) + ([] if dx is None else [f"scene.dx={dx!r}"])
+
+
+def field_level_dx() -> float:
+    """The ladder PST's grid spacing at the field protocol's resolution (m): its weak layer over
+    ``FieldProtocol.cells_across`` (4 cells: 15 mm), a level off the halving ladder."""
+    from ..field.protocol import FieldProtocol
+
+    return LADDER_WEAK_LAYER / FieldProtocol().cells_across
 
 
 def grid_bracket(lo: float, hi: float) -> dict:

@@ -210,6 +210,42 @@ def _precision(data: dict, name: str, levels: list[dict]) -> list[str]:
     return out
 
 
+def field_level_errors(data: dict) -> list[str] | None:
+    """The PST's error per quantity at the field protocol's resolution (``field_level``, off the ladder), as
+    ``'critical cut 5.6 %'``; None where that level has not run."""
+    fl = data.get("field_level")
+    if not fl:
+        return None
+    runs = [r for r in ladder_levels(data, "pst") if finite(r.get("critical_cut"))]
+    out = []
+    for key, spec in QUANTITIES["pst"].items():
+        e = fl["errors"].get(key)
+        if e is None:
+            continue
+        if not finite(e["error"]):
+            out.append(f"{spec[0]}: no value")
+        elif key == "critical_cut" and runs and finite(fl["record"].get(key)) and _overlap(fl["record"], runs[-1]):
+            out.append(f"{spec[0]} {pct(e['error'])} (the brackets overlap: not resolved)")
+        else:
+            out.append(f"{spec[0]} {pct(e['error'])}")
+    return out
+
+
+def _field_level(data: dict) -> list[str]:
+    """The paragraph of the field protocol's resolution below the PST ladder."""
+    errs = field_level_errors(data)
+    if errs is None:
+        return []
+    r = data["field_level"]["record"]
+    vals = [f"{spec[0]} {_value(r, key, spec)}" for key, spec in QUANTITIES["pst"].items()]
+    note = f" ({r['note']})" if r.get("note") else ""
+    return ["", f"**At the field protocol's resolution** ({_cells(r)} across the layer, dx {fx(r['dx'], 1, 1e3)} mm, "
+            "a level off the halving ladder, `--field-level`; the field batch resolves every weak layer so, "
+            f"docs/field.md): {'; '.join(vals)}{note}. Off each quantity's reference in the table above: "
+            f"{'; '.join(errs)}. {count(r['n_particles'])} particles, {secs(r['wall_time_s'])} of wall time "
+            f"(commit {str(r.get('git_commit'))[:7]})."]
+
+
 @section("convergence", "Error against run time: the snow ladders", "convergence/results/error_vs_runtime_snow.json",
          "python benchmarks/convergence/error_vs_runtime_snow.py",
          figure="convergence/results/error_vs_runtime_snow.png",
@@ -227,7 +263,7 @@ def render_snow_ladders(data: dict, ctx) -> list[str]:
                 "`mpm_warp.studies.snow.LADDER_PST`); each level one bisection of the critical cut plus the base run"
                 + (f", whose crack speed is the mean over {fx(over[0], 1)}-{fx(over[1], 1)} m" if over else "") + ":",
                 ""]
-        out += render_ladder(data, "pst") + [""]
+        out += render_ladder(data, "pst") + _field_level(data) + [""]
     envs = [data] + ([{"environment": data["environment_pst"]}] if data.get("environment_pst") else [])
     out += [env_note(*envs, verb="last written") + " The levels ran on several dates and commits (each level's "
             "`git_commit` in the JSON); wall times are upper bounds on the shared CPU."]

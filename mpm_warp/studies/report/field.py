@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from statistics import median
 
+from .convergence import field_level_errors
 from .core import section
 from .fmt import count, env_note, fx, pct, secs, spct, table
 
@@ -147,6 +148,32 @@ def _cases(n: int) -> str:
     return "the one case" if n == 1 else f"the {n} cases"
 
 
+LADDER = "convergence/results/error_vs_runtime_snow.json"
+
+
+def _resolution(data: dict, ctx) -> list[str]:
+    """The cells across the weak layer the cases ran at, and the snow ladder's error there."""
+    cells = [c["setup"].split(" cells across")[0] for c in data.get("cases", [])
+             if c.get("status") == "ok" and " cells across" in (c.get("setup") or "")]
+    if not cells:
+        return []
+    n = {k: cells.count(k) for k in sorted(set(cells), reverse=True)}
+    used = ", ".join(f"{count(v)} at {k} cells" for k, v in n.items())
+    want = data["selection"].get("protocol", {}).get("cells_across")
+    ladder = ctx.load(LADDER) or {}
+    errs = field_level_errors(ladder)
+    lv = (ladder.get("field_level") or {}).get("record", {})
+    if errs and want is not None and round(lv.get("cells_across_layer", -1)) == want:
+        said = (f"On the snow ladder's PST at {want} cells (a 30 cm slab on a 6 cm layer, dx {fx(lv['dx'], 0, 1e3)} "
+                "mm; docs/results.md, \"Error against run time: the snow ladders\"), the error against the ladder's "
+                f"reference: {'; '.join(errs)}. A field column's layer is thinner, so its slab has more cells "
+                "than the ladder's at the same cells across the layer.")
+    else:
+        said = f"The snow ladder has no level at {want} cells across the layer: the resolution's error is not stated."
+    return ["", f"- **Resolution:** cells across the weak layer: {used} (3 where 4 would exceed the particle budget). "
+            + said]
+
+
 def _command_to(out: str):
     return lambda d: _batch_command(d, out)
 
@@ -209,6 +236,7 @@ def render_batch(data: dict, ctx) -> list[str]:
                 f"times steps), {fx(ns, 0)} ns of wall time a particle-step. {CASE_BUDGET_S:g} s at that rate is "
                 f"{fx(CASE_BUDGET_S / ns, 2)} G particle-steps: the median case's work is "
                 f"{fx(work * ns / 1e9 / CASE_BUDGET_S, 1)}x that."]
+    out += _resolution(data, ctx)
     read = [c for c in data.get("cases", []) if c.get("w_f_source") == "read back" and c.get("runaway_cut")
             and c.get("recorded_cut")]
     if read:
