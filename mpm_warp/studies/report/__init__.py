@@ -34,6 +34,7 @@ from . import (  # noqa: F401
     convergence,
     field,
     field_pre_cut,
+    field_resolution,
     field_rigid_base,
     field_slab,
     field_slab_fe,

@@ -262,21 +262,29 @@ MEASURED = "field/results/measured/field_batch.json"
          _command_to("benchmarks/field/results/rate"), question="How long does a field case take, and how many cases "
          "an hour does the batch run, with one Dask worker whose cases each step on both cores?")
 def render_rate(data: dict, ctx) -> list[str]:
-    """:func:`render_batch`, and the same cases against their run in the measured-density batch (2 workers of one
-    thread): each case's wall time there over here."""
+    """:func:`render_batch`, and the same cases against their run in the measured-density batch: each case's wall
+    time there over here, where both batches ran one protocol."""
     out = render_batch(data, ctx)
     other = ctx.load(MEASURED) or {}
     there = {c["id"]: c for c in other.get("cases", []) if c.get("status") == "ok"}
     pairs = [(there[c["id"]]["wall_s"], c["wall_s"]) for c in data.get("cases", [])
              if c.get("status") == "ok" and c["id"] in there]
-    if pairs:
-        r = sorted(a / b for a, b in pairs)
-        med = median(r)
-        out[-1:-1] = [f"- **Against two workers of one thread:** the same {len(pairs)} cases took "
-                      f"{', '.join(secs(a) for a, _ in pairs)} each in the measured-density batch (2 workers of one "
-                      f"thread, {fx(other.get('cases_per_hour'), 0)} cases an hour over its "
-                      f"{count(other['scores']['cases'])} cases) and {', '.join(secs(b) for _, b in pairs)} here: each "
-                      f"case {fx(med, 2)}x sooner (median; {fx(r[0], 2)}-{fx(r[-1], 2)}x).", ""]
+    if not pairs:
+        return out
+    proto, proto_there = data["selection"].get("protocol"), other["selection"].get("protocol")
+    if proto != proto_there:
+        out[-1:-1] = ["- **Against the measured-density batch:** not compared: the two batches ran different field "
+                      "protocols (the JSONs' `selection.protocol`), so a case's wall time there is another run's.", ""]
+        return out
+    config = (f"{_workers(other.get('workers'))} of {_threads(other.get('threads_per_case', 1))}")
+    r = sorted(a / b for a, b in pairs)
+    med = median(r)
+    rate = (f", {fx(other['cases_per_hour'], 0)} cases an hour over its {count(other['scores']['cases'])} cases"
+            if other.get("cases_per_hour") else "")
+    out[-1:-1] = [f"- **Against {config}:** the same {len(pairs)} cases took "
+                  f"{', '.join(secs(a) for a, _ in pairs)} each in the measured-density batch ({config}{rate}) and "
+                  f"{', '.join(secs(b) for _, b in pairs)} here: each case {fx(med, 2)}x "
+                  f"{'sooner' if med >= 1 else 'later'} here (median; {fx(r[0], 2)}-{fx(r[-1], 2)}x).", ""]
     return out
 
 
