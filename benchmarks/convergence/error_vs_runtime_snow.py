@@ -381,10 +381,12 @@ def run_field_level(a, name: str) -> int:
     rec["device"] = a.device
     rec["git_commit"] = environment(a.device).get("git_commit")
     data = load(a.results, name)
-    data["environment_field_level"] = environment(a.device)
+    env = environment(a.device)
+    env["load_average_at_end_1_5_15_min"] = list(os.getloadavg())
+    data["environment_field_level"] = env
     errors = errors_against_reference(rec, data.get("summary", {}).get("pst", {}), QUANTITIES["pst"])
     data["field_level"] = {"record": rec, "errors": errors}
-    write_json(name, data, a.results)
+    write_json(name, data, a.results, end_load=False)     # the ladder's own environment stays as its levels left it
     print(json.dumps({q: e["error"] for q, e in data["field_level"]["errors"].items()}), flush=True)
     print("results in", a.results, flush=True)
     return 0
