@@ -243,7 +243,16 @@ def _field_level(data: dict) -> list[str]:
             "a level off the halving ladder, `--field-level`; the field batch resolves every weak layer so, "
             f"docs/field.md): {'; '.join(vals)}{note}. Off each quantity's reference in the table above: "
             f"{'; '.join(errs)}. {count(r['n_particles'])} particles, {secs(r['wall_time_s'])} of wall time "
-            f"(commit {str(r.get('git_commit'))[:7]})."]
+            f"(commit {str(r.get('git_commit'))[:7]}{_load(data.get('environment_field_level'))})."]
+
+
+def _load(env: dict | None) -> str:
+    """``', load average 2.4 at the start and 2.5 at the end'`` of an environment record ('' without one)."""
+    if not env or not env.get("load_average_1_5_15_min"):
+        return ""
+    end = env.get("load_average_at_end_1_5_15_min")
+    return (f", {env['date'][:10]}, load average {fx(env['load_average_1_5_15_min'][0], 1)} at the start"
+            + (f" and {fx(end[0], 1)} at the end" if end else "") + " on the 2 cores")
 
 
 @section("convergence", "Error against run time: the snow ladders", "convergence/results/error_vs_runtime_snow.json",
