@@ -114,8 +114,17 @@ def _differences(unc: dict) -> str:
             + ". An interval that holds 0 does not tell the model from that baseline.")
 
 
-def _verdict(sc: dict, m, best: float) -> str:
-    if sc["cases"] < 150:
+def _judged(data: dict) -> bool:
+    """Whether the batch ran its whole draw of at least 150 columns: every drawn column was run or refused in field
+    terms when built (a refusal is the protocol's answer for that column, not a case left out)."""
+    sel = data["selection"]
+    drawn = sum(sel.get(k, 0) for k in ("measured", "END", "SF", "ARR"))
+    refused = len(data.get("refused_at_build") or [])
+    return not sel.get("finished_only") and drawn >= 150 and data["scores"]["cases"] + refused >= drawn
+
+
+def _verdict(data: dict, m, best: float) -> str:
+    if not _judged(data):
         return "open"
     return "pass" if m is not None and m > best else "fail"
 
@@ -213,9 +222,11 @@ def render_batch(data: dict, ctx) -> list[str]:
                                                     sc["weac_static"]["balanced_accuracy"] or 0.0)
     med, alone, by_config = _case_median(sc)
     out += ["", f"**Check:** the model's balanced accuracy above both baselines': {_ba(sc['model'])} against "
-            f"{best:.2f}, **{_verdict(sc, m, best)}**"
-            + (" (too few cases to tell: at least 50 per class are needed; a balanced accuracy is over the observed "
-               "classes present)" if sc["cases"] < 150 else "") + "." + _differences(unc), "",
+            f"{best:.2f}, **{_verdict(data, m, best)}**"
+            + (" (too few cases to tell: a whole draw of at least 150 columns, 50 per class, is needed; a balanced "
+               "accuracy is over the observed classes present)" if not _judged(data) else
+               f" (the whole draw: {count(len(data.get('refused_at_build') or []))} of its columns refused when "
+               f"built, {count(sc['cases'])} scored)") + "." + _differences(unc), "",
             f"**Check:** the median field case within {CASE_BUDGET_S:g} s of wall time{alone}: {secs(med)}, "
             f"**{'pass' if med is not None and med <= CASE_BUDGET_S else 'fail'}** ({by_config}particle budget "
             f"{count(sel['max_particles'])}, {_threads(data.get('threads_per_case', 1))} per case, "
