@@ -118,11 +118,34 @@ def _field(ctx: Context) -> str | None:
             f"terms ([Field pits in]({_link('Field pits in')})).")
 
 
+def _outcomes(ctx: Context) -> str | None:
+    """The field outcomes against the observers: the model's balanced accuracy beside both baselines'."""
+    data = ctx.load("field/results/field_batch.json")
+    if data is None or data["selection"].get("finished_only"):
+        return None
+    sc = data["scores"]
+    iv = (sc.get("uncertainty") or {}).get("intervals") or {}
+
+    def ba(key: str) -> str:
+        b = iv.get(key)
+        return f"{sc[key]['balanced_accuracy']:.2f}" + (f" [{b[0]:.2f}, {b[1]:.2f}]" if b and b[0] != b[1] else "")
+
+    rec = sc["model"]["recall"]
+    m = sc["model"]["balanced_accuracy"]
+    above = all(m > sc[k]["balanced_accuracy"] for k in ("majority", "weac_static"))
+    return (f"- **Field outcomes:** on {sc['cases']:,} real PSTs drawn by observed class, the model's END/SF/ARR "
+            f"balanced accuracy is {ba('model')}, against {ba('majority')} for always answering one class and "
+            f"{ba('weac_static')} for a static rule from weac's slab stress: "
+            f"{'above both' if above else 'not above both'}. Its recall: END {rec['END']:.0%}, SF {rec['SF']:.0%}, "
+            f"ARR {rec['ARR']:.0%} ([Field outcomes against the observers]"
+            f"({_link('Field outcomes against the observers')})).")
+
+
 def headlines(ctx: Context) -> list[str]:
     """The README's headline bullets (a bullet whose results are not committed is left out)."""
     out = [_throughput(ctx, "perf/results/throughput_cpu.json", 3, "Throughput beside Taichi, 3D"),
            _throughput(ctx, "perf/results/throughput_2d_cpu.json", 2, "Throughput beside Taichi, 2D"),
-           _pst_speed(ctx), _critical_cut(ctx), _slope(ctx), _shear(ctx), _field(ctx)]
+           _pst_speed(ctx), _critical_cut(ctx), _slope(ctx), _shear(ctx), _field(ctx), _outcomes(ctx)]
     return [b for b in out if b]
 
 
