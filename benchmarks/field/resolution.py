@@ -3,14 +3,14 @@
 The field protocol resolves each weak layer with 4 grid cells (``FieldProtocol.cells_across``), where the snow
 ladder's PST is still far from converged (its error at 4 cells: ``error_vs_runtime_snow.py --field-level``). What
 the batch scores is the class, so this study asks whether the class, and where the crack ran away, change when
-the same columns run finer. It draws ``--cases`` of a field batch's finished 4-cell cases at random (``--seed``;
-a choice blind to the outcome) among those whose batch run took at most ``--max-wall`` seconds (the finer run
-costs about (6/4)^3 = 3.4 times as much), and runs each again from its checkpoint's scenario with the grid
-spacing times 4/6, nothing else changed (the slab's crack band follows the grid: one particle spacing, docs/model.md
-§9). Per case: the predicted class, the runaway cut, where the slab broke, particles, steps and wall time at
-both resolutions. Writes ``benchmarks/field/results/field_resolution.json``.
+the same columns run finer. It draws ``--per-class`` of a field batch's finished 4-cell cases of each observed
+class at random (``--seed``; blind to the predicted outcome) among those whose batch run took at most
+``--max-wall`` seconds (the finer run costs about (6/4)^3 = 3.4 times as much), and runs each again from its
+checkpoint's scenario with the grid spacing times 4/6, nothing else changed (the slab's crack band follows the
+grid: one particle spacing, docs/model.md §9). Per case: the predicted class, the runaway cut, where the slab
+broke, particles, steps and wall time at both resolutions. Writes ``benchmarks/field/results/field_resolution.json``.
 
-Usage: ``python benchmarks/field/resolution.py RUNDIR [RUNDIR ...] [--cases N] [--seed S] [--max-wall W]
+Usage: ``python benchmarks/field/resolution.py RUNDIR [RUNDIR ...] [--per-class N] [--seed S] [--max-wall W]
 [--threads T]``; ``--quick``: one case of at most 20 s, to a temporary folder. Minutes a case.
 """
 
@@ -66,7 +66,7 @@ def rerun(rec: dict, run_dir: str, folder: str, cells: int, n_threads: int) -> d
 def main(argv=None) -> int:
     ap = parser(__doc__, "one case of at most 20 s, to a temporary folder")
     ap.add_argument("runs", nargs="+", help="runs folders of a field batch")
-    ap.add_argument("--cases", type=int, default=10, help="how many cases to draw (default 10)")
+    ap.add_argument("--per-class", type=int, default=4, help="cases to draw per observed class (default 4)")
     ap.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
     ap.add_argument("--max-wall", type=float, default=60.0,
                     help="draw among the cases whose batch run took at most this long (s, default 60)")
@@ -78,7 +78,12 @@ def main(argv=None) -> int:
     pool = sorted(((r, d) for r, d in run_records(a.runs)
                    if os.path.exists(os.path.join(d, r["id"] + ".ckpt.h5")) and r.get("setup", "").startswith(coarse)
                    and r["wall_s"] <= cap), key=lambda rd: rd[0]["id"])
-    chosen = random.Random(a.seed).sample(pool, min(1 if a.quick else a.cases, len(pool)))
+    rng = random.Random(a.seed)
+    chosen = []
+    for cls in ("END", "SF", "ARR"):
+        of = [rd for rd in pool if rd[0]["observed"] == cls]
+        chosen += rng.sample(of, min(a.per_class, len(of)))
+    chosen = chosen[:1] if a.quick else chosen
     folder = out_dir(a, RESULTS, "resolution")
     runs = tempfile.mkdtemp(prefix="mpm_warp_resolution_")
     cases = []
@@ -88,9 +93,9 @@ def main(argv=None) -> int:
         print(f"[{k + 1}/{len(chosen)}] {c['test']}: {c['coarse']['predicted']} -> {c['fine']['predicted']}, runaway "
               f"{c['coarse']['runaway_cut']} -> {c['fine']['runaway_cut']}, {c['fine']['wall_s']:.0f} s", flush=True)
     data = {"name": "field_resolution", "runs": [os.path.basename(os.path.normpath(r)) for r in a.runs],
-            "cells": [FieldProtocol.cells_across, FINER], "seed": a.seed, "max_wall_s": cap,
-            "chosen": f"{len(chosen)} drawn (seed {a.seed}) from the {len(pool)} finished {coarse} the weak layer "
-                      f"whose batch run took at most {cap:g} s",
+            "cells": [FieldProtocol.cells_across, FINER], "seed": a.seed, "max_wall_s": cap, "per_class": a.per_class,
+            "chosen": f"{len(chosen)} drawn ({a.per_class} per observed class, seed {a.seed}) from the {len(pool)} "
+                      f"finished cases at {coarse} the weak layer whose batch run took at most {cap:g} s",
             "cases": cases, "environment": environment("cpu")}
     print("wrote", write_json("field_resolution", data, folder))
     return 0

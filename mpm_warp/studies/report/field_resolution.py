@@ -15,7 +15,7 @@ def _change(c: dict):
 
 
 @section("field", "The grid: the same columns at 6 cells across the weak layer", "field/results/field_resolution.json",
-         lambda d: f"python benchmarks/field/resolution.py RUNDIR --cases {len(d['cases'])} --seed {d['seed']} "
+         lambda d: f"python benchmarks/field/resolution.py RUNDIR --per-class {d['per_class']} --seed {d['seed']} "
                    f"--max-wall {d['max_wall_s']:g}",
          question="Does a field case keep its class, and its runaway cut, when its column runs on a finer grid "
                   "than the field protocol's 4 cells across the weak layer?")
