@@ -179,8 +179,8 @@ def _resolution(data: dict, ctx) -> list[str]:
                 "than the ladder's at the same cells across the layer.")
     else:
         said = f"The snow ladder has no level at {want} cells across the layer: the resolution's error is not stated."
-    return ["", f"- **Resolution:** cells across the weak layer: {used} (3 where 4 would exceed the particle budget). "
-            + said]
+    budget = (f" ({want - 1} where {want} would exceed the particle budget)" if want and str(want - 1) in n else "")
+    return ["", f"- **Resolution:** cells across the weak layer: {used}{budget}. " + said]
 
 
 def _command_to(out: str):
