@@ -2,11 +2,24 @@
 
 from __future__ import annotations
 
+import re
 from statistics import median
 
 from .core import section
 from .field_rigid_base import CUT_SHARE, _cut
 from .fmt import check_line, count, env_note, fx, spct, table
+
+
+def _depth(test: str) -> float | None:
+    """The weak layer's depth (cm) in a field line ``PST 30/100 (End) down 41 cm``."""
+    m = re.search(r"down (\d+(?:\.\d+)?) cm", test)
+    return float(m.group(1)) if m else None
+
+
+def _recorded(test: str) -> float | None:
+    """The recorded cut (m) of a field line ``PST 30/100 (End) down 41 cm``."""
+    m = re.match(r"PST (\d+(?:\.\d+)?)/", test)
+    return float(m.group(1)) / 100.0 if m else None
 
 
 def _change(c: dict):
@@ -40,7 +53,8 @@ def render_resolution(data: dict, ctx) -> list[str]:
     far = [f"`{c['test']}` {spct(ch)}" for c in cases if (ch := _change(c)) is not None and abs(ch) > CUT_SHARE]
     moved = [f"`{c['test']}` ({c['observed']}): {c['coarse']['predicted']} -> {c['fine']['predicted']}"
              for c, s in zip(cases, same, strict=True) if not s]
-    cost = [b["wall_s"] / a["wall_s"] for a, b in ((c["coarse"], c["fine"]) for c in cases) if a.get("wall_s")]
+    same_threads = [c["fine"]["wall_s"] / c["coarse"]["wall_s"] for c in cases
+                    if c["coarse"].get("wall_s") and c["coarse"].get("threads") == c["fine"].get("threads")]
     out += ["", check_line(f"the predicted class at {lo} and at {hi} cells", "the same in every case", all(same),
                            f"{sum(same)} of {len(same)}" + (f"; changed: {'; '.join(moved)}" if moved else "")),
             check_line(f"the runaway cut at {lo} and at {hi} cells", f"within {fx(100 * CUT_SHARE, 0)} % in every case "
@@ -48,9 +62,24 @@ def render_resolution(data: dict, ctx) -> list[str]:
                        f"{len(changes) - len(far)} of {len(changes)}, from {spct(min(changes))} to "
                        f"{spct(max(changes))}" + (f"; apart: {', '.join(far)}" if far else "")
                        if changes else "no case ran away at both"), ""]
-    if cost:
-        out += [f"- Cost: the {hi}-cell runs took {fx(min(cost), 2)} to {fx(max(cost), 2)} times the wall time of the "
-                f"{lo}-cell ones (median {fx(median(cost), 2)}x; the {lo}-cell runs are the batch's own, the {hi}-cell "
-                f"ones ran one at a time on {cases[0]['fine'].get('threads', 1)} threads).", ""]
+    far_cases = [c for c in cases if (ch := _change(c)) is not None and abs(ch) > CUT_SHARE]
+    if far_cases:
+        parts, closer = [], []
+        for c in far_cases:
+            a, b, rec, d = c["coarse"]["runaway_cut"], c["fine"]["runaway_cut"], _recorded(c["test"]), _depth(c["test"])
+            where = (f"the slab {fx(d, 0)} cm, about {fx(d / 100 / c['dx'][0], 0)} cells deep at {lo} cells across "
+                     "the layer; " if d is not None else "")
+            parts.append(f"`{c['test']}` ({where}{_cut(a)} -> {_cut(b)} m, recorded {_cut(rec)} m)")
+            if rec is not None:
+                closer.append(abs(b - rec) < abs(a - rec))
+        toward = ("" if not closer else " On the finer grid each came closer to the recorded cut." if all(closer) else
+                  " On the finer grid not every one came closer to the recorded cut.")
+        out += [f"- The runaway cuts that moved by more than {fx(100 * CUT_SHARE, 0)} %: {'; '.join(parts)} (depth "
+                f"measured vertically, as the observer writes it).{toward}", ""]
+    if same_threads:
+        out += [f"- Cost: over the {len(same_threads)} cases whose {lo}-cell run (the batch's own) also had "
+                f"{cases[0]['fine'].get('threads', 1)} threads to itself, the {hi}-cell runs took "
+                f"{fx(min(same_threads), 2)} to {fx(max(same_threads), 2)} times the wall time (median "
+                f"{fx(median(same_threads), 2)}x; (6/4)^3 = 3.4 in particle-steps).", ""]
     out += [env_note(data)]
     return out
