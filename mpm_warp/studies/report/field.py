@@ -158,6 +158,7 @@ def _cases(n: int) -> str:
 
 
 LADDER = "convergence/results/error_vs_runtime_snow.json"
+RESOLUTION = "field/results/field_resolution.json"
 
 
 def _resolution(data: dict, ctx) -> list[str]:
@@ -180,6 +181,12 @@ def _resolution(data: dict, ctx) -> list[str]:
     else:
         said = f"The snow ladder has no level at {want} cells across the layer: the resolution's error is not stated."
     budget = (f" ({want - 1} where {want} would exceed the particle budget)" if want and str(want - 1) in n else "")
+    res = ctx.load(RESOLUTION)
+    if res and res.get("cases"):
+        same = sum(c["coarse"]["predicted"] == c["fine"]["predicted"] for c in res["cases"])
+        said += (f" On field columns themselves, {same} of {len(res['cases'])} drawn cases kept their class at "
+                 f"{res['cells'][1]} cells across the weak layer (docs/results.md, \"The grid: the same columns at "
+                 f"{res['cells'][1]} cells across the weak layer\").")
     return ["", f"- **Resolution:** cells across the weak layer: {used}{budget}. " + said]
 
 
