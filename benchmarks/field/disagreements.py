@@ -37,28 +37,30 @@ def scenario_of(run_dir: str, case_id: str):
     return resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck) if os.path.exists(ck) else None
 
 
-def from_checkpoint(run_dir: str, case_id: str, sc) -> tuple[float | None, float | None]:
+def from_checkpoint(run_dir: str, case_id: str, sc) -> tuple[float | None, float | None, str | None]:
     """From the run's final checkpoint: the slab's largest ``kappa / tensile strength`` (>= 1: it cracked
-    somewhere), and the fastest material's P-wave speed over the slab's fastest (> 1: the substratum, not the
-    slab, sets the time step); Nones without a checkpoint (``sc``: its scenario, :func:`scenario_of`)."""
+    somewhere), the fastest material's P-wave speed over the slab's fastest (> 1: another material, not the
+    slab, sets the time step) and that material's name; Nones without a checkpoint (``sc``: its scenario,
+    :func:`scenario_of`)."""
     import h5py
 
     from mpm_warp.model import Model
 
     ck = os.path.join(run_dir, case_id + ".ckpt.h5")
     if sc is None:
-        return None, None
+        return None, None, None
     model = Model(sc, "cpu")
     c_p = {name: m.p_wave_speed for name, m in sc.materials.items()}
     slab = max((v for k, v in c_p.items() if k.startswith("slab")), default=None)
     dt_ratio = max(c_p.values()) / slab if slab else None
+    fastest = max(c_p, key=c_p.get)
     with h5py.File(ck, "r") as f:
         kappa = f["kappa"][:] if "kappa" in f else None
     groups = [g for g in model.groups if g.material.model == "tensile_cracking"]
     if kappa is None or not groups:
-        return None, dt_ratio
+        return None, dt_ratio, fastest
     return max(float(kappa[g.kappa_start:g.kappa_start + g.count].max()) / g.material.tensile_strength
-               for g in groups), dt_ratio
+               for g in groups), dt_ratio, fastest
 
 
 #: m: the energy balance is read up to this far from the far end (where the cut column's last strip lets go)
@@ -91,7 +93,7 @@ def describe(rec: dict, case, run_dir: str) -> dict:
     p, slab = case.params, case.column.slab
     depth = sum(ly.thickness for ly in slab)
     sc = scenario_of(run_dir, rec["id"])
-    crack, dt_ratio = from_checkpoint(run_dir, rec["id"], sc)
+    crack, dt_ratio, fastest = from_checkpoint(run_dir, rec["id"], sc)
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "predicted": rec["predicted"],
             "static_class": rec.get("static_class"), "slab_depth_m": p.slab_depth,
             "slab_density": sum(ly.thickness * ly.density for ly in slab) / depth, "slope_deg": p.slope_angle,
@@ -101,7 +103,8 @@ def describe(rec: dict, case, run_dir: str) -> dict:
             "slab_fracture_at": rec.get("slab_fracture_at"), "slab_crack_ratio": crack,
             "energy_beyond_cut": energy_beyond_cut(sc, rec),
             "substratum_share": p.substratum_depth / (p.slab_depth + p.weak_layer_thickness + p.substratum_depth),
-            "c_p_over_slab": dt_ratio, "particles": rec.get("particles"), "steps": rec.get("steps"),
+            "c_p_over_slab": dt_ratio, "fastest_material": fastest,
+            "rigid_base": bool(sc.scene.rigid_base) if sc is not None else None, "particles": rec.get("particles"), "steps": rec.get("steps"),
             "wall_s": rec.get("wall_s")}
 
 
@@ -133,7 +136,11 @@ def cost(rows: list[dict]) -> dict:
             "substratum_share_range": [min(r["substratum_share"] for r in rows),
                                        max(r["substratum_share"] for r in rows)] if rows else None,
             "substratum_sets_dt": len(faster), "c_p_over_slab_median_there": _median(faster),
-            "c_p_over_slab_max": max(faster, default=None)}
+            "c_p_over_slab_max": max(faster, default=None),
+            "rigid_base": sum(bool(r.get("rigid_base")) for r in rows),
+            "faster_materials": sorted({r["fastest_material"].rstrip("_0123456789") for r in rows
+                                        if r.get("fastest_material") and r["c_p_over_slab"] is not None
+                                        and r["c_p_over_slab"] > 1.0 + 1e-9})}
 
 
 def main(argv=None) -> int:
