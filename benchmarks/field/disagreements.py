@@ -104,7 +104,8 @@ def describe(rec: dict, case, run_dir: str) -> dict:
             "energy_beyond_cut": energy_beyond_cut(sc, rec),
             "substratum_share": p.substratum_depth / (p.slab_depth + p.weak_layer_thickness + p.substratum_depth),
             "c_p_over_slab": dt_ratio, "fastest_material": fastest,
-            "rigid_base": bool(sc.scene.rigid_base) if sc is not None else None, "particles": rec.get("particles"), "steps": rec.get("steps"),
+            "rigid_base": bool(sc.scene.rigid_base) if sc is not None else None,
+            "particles": rec.get("particles"), "steps": rec.get("steps"),
             "wall_s": rec.get("wall_s")}
 
 

@@ -345,8 +345,8 @@ def _substratum(c: dict | None) -> list[str]:
     rigid = c.get("rigid_base", 0)
     if rigid and rigid == c["cases"]:
         who = " and ".join(m.replace("_", " ") for m in c.get("faster_materials", [])) or "another material"
-        return ["", f"- **The column's cost beside the crack:** every run stands on a rigid base, so the profile's snow "
-                f"below the weak layer ({share}) is not run. A material faster than the slab (its P-wave speed; "
+        return ["", "- **The column's cost beside the crack:** every run stands on a rigid base, so the profile's "
+                f"snow below the weak layer ({share}) is not run. A material faster than the slab (its P-wave speed; "
                 f"here the {who}) {faster}."]
     return ["", f"- **The column's cost beside the crack:** the substratum (the profile's snow below the weak layer, "
             f"docs/profiles.md) is {share}, and its P-wave speed, above the slab's, {faster}."]
