@@ -24,10 +24,9 @@ import warnings
 
 from mpm_warp.config import TimeControl
 from mpm_warp.field.batch import run_records
-from mpm_warp.field.protocol import decided
+from mpm_warp.field.protocol import run_until_decided
 from mpm_warp.io.checkpoint import read_checkpoint_meta
 from mpm_warp.loader import resolved_scenario
-from mpm_warp.runner import run
 from mpm_warp.scenes.pst import build
 from mpm_warp.scenes.pst.static import static_column
 from mpm_warp.scenes.weac_reference import critical_cut
@@ -51,12 +50,7 @@ def rerun(rec: dict, run_dir: str, folder: str, share: float) -> dict:
     t_end = sc.time.end - pre / p.saw.speed               # the protocol's end, less the way the blade skips
     scenario = build(cut, TimeControl(end=t_end, frame_interval=sc.time.frame_interval), name="field")
     t0 = time.perf_counter()
-    res = run(scenario, os.path.join(folder, rec["id"] + ".h5"), device="cpu", overwrite=True, n_threads=1,
-              callback=lambda sim, frame: not decided(sim))
-    o = res.scene_result.get("outcome", {})
-    pre_run = {"predicted": o.get("class"), "runaway_cut": res.scene_result.get("runaway_cut"),
-               "slab_fracture_at": o.get("slab_fracture_at"), "particles": res.n_particles, "steps": res.steps,
-               "wall_s": res.wall_time, "sim_time": res.sim_time}
+    pre_run = run_until_decided(scenario, os.path.join(folder, rec["id"] + ".h5"), 1)
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "setup": rec["setup"],
             "static_cut": static, "pre_cut": pre, "without": {k: rec.get(k) for k in KEYS}, "with": pre_run,
             "case_wall_s": time.perf_counter() - t0}

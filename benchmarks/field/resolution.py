@@ -26,10 +26,9 @@ import warnings
 
 from mpm_warp.config import TimeControl
 from mpm_warp.field.batch import run_records
-from mpm_warp.field.protocol import FieldProtocol, decided
+from mpm_warp.field.protocol import FieldProtocol, run_until_decided
 from mpm_warp.io.checkpoint import read_checkpoint_meta
 from mpm_warp.loader import resolved_scenario
-from mpm_warp.runner import run
 from mpm_warp.scenes.pst import build
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -51,12 +50,7 @@ def rerun(rec: dict, run_dir: str, folder: str, cells: int, n_threads: int) -> d
     fine = dataclasses.replace(p, dx=p.dx * coarse / cells)
     scenario = build(fine, TimeControl(end=sc.time.end, frame_interval=sc.time.frame_interval), name="field")
     t0 = time.perf_counter()
-    res = run(scenario, os.path.join(folder, rec["id"] + ".h5"), device="cpu", overwrite=True, n_threads=n_threads,
-              callback=lambda sim, frame: not decided(sim))
-    o = res.scene_result.get("outcome", {})
-    fine_run = {"predicted": o.get("class"), "runaway_cut": res.scene_result.get("runaway_cut"),
-                "slab_fracture_at": o.get("slab_fracture_at"), "particles": res.n_particles, "steps": res.steps,
-                "wall_s": res.wall_time, "sim_time": res.sim_time, "threads": n_threads}
+    fine_run = {**run_until_decided(scenario, os.path.join(folder, rec["id"] + ".h5"), n_threads), "threads": n_threads}
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "setup": rec["setup"],
             "cells": [coarse, cells], "dx": [p.dx, fine.dx],
             "coarse": {**{k: rec.get(k) for k in KEYS}, "threads": rec.get("threads")}, "fine": fine_run,

@@ -25,10 +25,9 @@ import warnings
 
 from mpm_warp.config import TimeControl
 from mpm_warp.field.batch import run_records
-from mpm_warp.field.protocol import decided
+from mpm_warp.field.protocol import run_until_decided
 from mpm_warp.io.checkpoint import read_checkpoint_meta
 from mpm_warp.loader import resolved_scenario
-from mpm_warp.runner import run
 from mpm_warp.scenes.pst import PSTParams, build
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -64,12 +63,7 @@ def rerun(rec: dict, run_dir: str, folder: str) -> dict:
     scenario = build(on_rigid_base(sc.scene), TimeControl(end=sc.time.end, frame_interval=sc.time.frame_interval),
                      name="field")
     t0 = time.perf_counter()
-    res = run(scenario, os.path.join(folder, rec["id"] + ".h5"), device="cpu", overwrite=True, n_threads=1,
-              callback=lambda sim, frame: not decided(sim))
-    o = res.scene_result.get("outcome", {})
-    rigid = {"predicted": o.get("class"), "runaway_cut": res.scene_result.get("runaway_cut"),
-             "slab_fracture_at": o.get("slab_fracture_at"), "particles": res.n_particles, "steps": res.steps,
-             "wall_s": res.wall_time, "sim_time": res.sim_time}
+    rigid = run_until_decided(scenario, os.path.join(folder, rec["id"] + ".h5"), 1)
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "setup": rec["setup"],
             "compliance_ratio": compliance_ratio(sc.scene), "substratum_m": sc.scene.substratum_depth,
             "substratum": {k: rec.get(k) for k in KEYS}, "rigid": rigid, "case_wall_s": time.perf_counter() - t0}

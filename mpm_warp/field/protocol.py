@@ -24,7 +24,7 @@ from ..config import TimeControl
 from ..errors import InvalidArgument
 from ..scenes.pst import PSTParams
 
-__all__ = ["FieldProtocol", "protocol_params", "decided", "particle_estimate"]
+__all__ = ["FieldProtocol", "protocol_params", "decided", "particle_estimate", "run_until_decided"]
 
 
 @dataclass(frozen=True)
@@ -128,3 +128,17 @@ def decided(sim) -> bool:
     """Whether the PST running in ``sim`` has its outcome (END, SF, or an arrest or no propagation once the saw is
     done): the batch stops a run there."""
     return sim.monitors["pst"].outcome().get("class") is not None
+
+
+def run_until_decided(scenario, path: str, n_threads: int = 1) -> dict:
+    """Run a field column's ``scenario`` on the CPU into ``path`` (overwritten) until its outcome is decided, as a
+    batch does: the row the field studies compare (``predicted``, ``runaway_cut`` (m), ``slab_fracture_at`` (m),
+    ``particles``, ``steps``, ``wall_s`` (s), ``sim_time`` (s))."""
+    from ..runner import run
+
+    res = run(scenario, path, device="cpu", overwrite=True, n_threads=n_threads,
+              callback=lambda sim, frame: not decided(sim))
+    o = res.scene_result.get("outcome", {})
+    return {"predicted": o.get("class"), "runaway_cut": res.scene_result.get("runaway_cut"),
+            "slab_fracture_at": o.get("slab_fracture_at"), "particles": res.n_particles, "steps": res.steps,
+            "wall_s": res.wall_time, "sim_time": res.sim_time}
