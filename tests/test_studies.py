@@ -22,7 +22,7 @@ from mpm_warp.studies.convergence import (
 )
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser, result_name
-from mpm_warp.studies.snow import field_level_dx, grid_bracket, merge_pst_parts
+from mpm_warp.studies.snow import field_level_dx, grid_bracket, merge_pst_parts, split_pst_parts
 
 CONVERGENCE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "benchmarks", "convergence",
                            "results")
@@ -162,6 +162,28 @@ def test_a_levels_base_run_and_critical_cut_merge_in_either_order():
         assert merged["git_commit"] == "b" and merged["git_commit_base_run"] == "a"
     assert merge_pst_parts(cut, None)["part"] == "critical_cut"
     assert merge_pst_parts({**base, "part": "base_run"}, None)["part"] == "base_run"
+
+
+def test_a_critical_cut_run_again_replaces_only_that_part_of_a_merged_level():
+    """Rerunning a level's narrowed critical cut (``--redo --pst-bracket``) over a record of both parts keeps
+    the base run's speed, wall time, steps and commit, and takes the new search's cut, time and commit."""
+    base = {"dx": 0.0025, "precision": "float32", "level": 3, "note": "base run only (critical cut not bisected)",
+            "critical_cut": float("nan"), "speed": 22.0, "touchdown": 0.74, "collapse_height": 0.007,
+            "wall_time_s": 8000.0, "steps": 130000, "n_particles": 591360, "git_commit": "a"}
+    cut = {"dx": 0.0025, "precision": "float32", "level": 3, "part": "critical_cut", "critical_cut": 0.315625,
+           "critical_cut_bracket": [0.30625, 0.325], "bracketed": True, "critical_cut_note": "", "trials": [{}],
+           "critical_cut_wall_s": 3000.0, "critical_cut_steps": 100000, "bisection": {"lo": 0.30625},
+           "speed": float("nan"), "wall_time_s": 3000.0, "steps": 100000, "n_particles": 591360, "git_commit": "b"}
+    both = merge_pst_parts(cut, base)
+    again = {**cut, "critical_cut": 0.334375, "critical_cut_wall_s": 2500.0, "critical_cut_steps": 90000,
+             "wall_time_s": 2500.0, "steps": 90000, "git_commit": "c"}
+    merged = merge_pst_parts(again, both)
+    assert merged["part"] == "both" and merged["critical_cut"] == 0.334375 and merged["speed"] == 22.0
+    assert merged["wall_time_s"] == 10500.0 and merged["steps"] == 220000
+    assert merged["git_commit"] == "c" and merged["git_commit_base_run"] == "a"
+    parts = split_pst_parts(both)
+    assert parts["base_run"]["wall_time_s"] == 8000.0 and parts["base_run"]["git_commit"] == "a"
+    assert parts["critical_cut"]["critical_cut"] == 0.315625 and parts["critical_cut"]["git_commit"] == "b"
 
 
 

@@ -352,6 +352,7 @@ def main(argv=None) -> int:
             rec["git_commit"] = commit                    # levels may come from different runs
             data = load(a.results, name)   # merged into what is there now: another process may have written levels
             data["environment"] = environment(a.device)
+            data.pop("environment_pst", None)        # an older layout's second environment: each level names its code
             have = data["ladders"].setdefault(ladder, [])
             if ladder == "pst" and (a.pst_bracket or a.base_only):    # the level's other part, when there
                 other = [x for x in have if x.get("level") == i and x["precision"] == prec]

@@ -9,12 +9,15 @@ the layer. The error ladder (``benchmarks/convergence/error_vs_runtime_snow.py``
 
 from __future__ import annotations
 
+import math
+
 from ..errors import InvalidArgument
 
 __all__ = ["LADDER_PST", "LADDER_WEAK_LAYER",
            "PST_DX", "PST_BRACKET", "SHEAR_CELLS", "FIELD_SPEED", "LONG_PST_SPEED", "DEM_STEADY_MAX",
            "SUPERSHEAR_MAX", "STEADY_FROM", "FIELD_CUT",
-           "PST_CUT_FIELDS", "ladder_pst", "field_level_dx", "grid_bracket", "pst_part", "merge_pst_parts"]
+           "PST_CUT_FIELDS", "ladder_pst", "field_level_dx", "grid_bracket", "pst_part", "merge_pst_parts",
+           "split_pst_parts"]
 
 #: The ladder PST's weak layer (m).
 LADDER_WEAK_LAYER = 0.06
@@ -91,6 +94,22 @@ def pst_part(rec: dict) -> str:
     return rec.get("part") or ("base_run" if rec.get("note", "").startswith("base run only") else "both")
 
 
+def split_pst_parts(rec: dict) -> dict:
+    """The parts of a PST level's record, by name: the inverse of :func:`merge_pst_parts` for a ``both``.
+
+    A record of both parts run apart gives back its base run (its own wall time, steps and commit)
+    and its critical-cut search; any other record is the one part it holds.
+    """
+    if pst_part(rec) != "both" or "git_commit_base_run" not in rec:
+        return {pst_part(rec): rec}
+    base = {k: v for k, v in rec.items() if k not in PST_CUT_FIELDS and k != "git_commit_base_run"}
+    base.update(part="base_run", git_commit=rec["git_commit_base_run"], critical_cut=math.nan,
+                wall_time_s=rec["wall_time_s"] - rec["critical_cut_wall_s"],
+                steps=rec["steps"] - rec["critical_cut_steps"], note="base run only (critical cut not bisected)")
+    cut = {**{k: rec[k] for k in PST_CUT_FIELDS if k in rec}, "part": "critical_cut", "git_commit": rec["git_commit"]}
+    return {"base_run": base, "critical_cut": cut}
+
+
 def merge_pst_parts(new: dict, old: dict | None) -> dict:
     """One level's record from its base run and its narrowed critical-cut search, run apart in either order.
 
@@ -99,8 +118,8 @@ def merge_pst_parts(new: dict, old: dict | None) -> dict:
     says which part it holds, and the other part's quantities are nan.
     """
     parts = {pst_part(new): new}
-    if old is not None and pst_part(old) != "both" and pst_part(old) != pst_part(new):
-        parts[pst_part(old)] = old
+    if old is not None and pst_part(new) != "both":
+        parts = {**split_pst_parts(old), **parts}         # a part run again replaces that part only
     if len(parts) == 1:
         return {**new, "part": pst_part(new)}
     base, cut = parts["base_run"], parts["critical_cut"]

@@ -273,8 +273,7 @@ def render_snow_ladders(data: dict, ctx) -> list[str]:
                 + (f", whose crack speed is the mean over {fx(over[0], 1)}-{fx(over[1], 1)} m" if over else "") + ":",
                 ""]
         out += render_ladder(data, "pst") + _field_level(data) + [""]
-    envs = [data] + ([{"environment": data["environment_pst"]}] if data.get("environment_pst") else [])
-    out += [env_note(*envs, verb="last written") + " The levels ran on several dates and commits (each level's "
+    out += [env_note(data, verb="last written") + " The levels ran on several dates and commits (each level's "
             "`git_commit` in the JSON); wall times are upper bounds on the shared CPU."]
     return out
 
