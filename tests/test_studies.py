@@ -148,7 +148,8 @@ def test_narrowed_bracket_must_lie_on_the_full_searchs_grid():
         grid_bracket(0.34375, 0.30625)
 
 
-def test_a_levels_base_run_and_critical_cut_merge_in_either_order():
+def _level_parts() -> tuple[dict, dict]:
+    """A 24-cell level's base run (commit a) and narrowed critical-cut search (commit b), run apart."""
     base = {"dx": 0.0025, "precision": "float32", "level": 3, "note": "base run only (critical cut not bisected)",
             "critical_cut": float("nan"), "speed": 22.0, "touchdown": 0.74, "collapse_height": 0.007,
             "wall_time_s": 8000.0, "steps": 130000, "n_particles": 591360, "git_commit": "a"}
@@ -156,6 +157,11 @@ def test_a_levels_base_run_and_critical_cut_merge_in_either_order():
            "critical_cut_bracket": [0.30625, 0.325], "bracketed": True, "critical_cut_note": "", "trials": [{}],
            "critical_cut_wall_s": 3000.0, "critical_cut_steps": 100000, "bisection": {"lo": 0.30625},
            "speed": float("nan"), "wall_time_s": 3000.0, "steps": 100000, "n_particles": 591360, "git_commit": "b"}
+    return base, cut
+
+
+def test_a_levels_base_run_and_critical_cut_merge_in_either_order():
+    base, cut = _level_parts()
     for merged in (merge_pst_parts(cut, base), merge_pst_parts({**base, "part": "base_run"}, cut)):
         assert merged["part"] == "both" and merged["critical_cut"] == 0.315625 and merged["speed"] == 22.0
         assert merged["wall_time_s"] == 11000.0 and merged["steps"] == 230000
@@ -167,13 +173,7 @@ def test_a_levels_base_run_and_critical_cut_merge_in_either_order():
 def test_a_critical_cut_run_again_replaces_only_that_part_of_a_merged_level():
     """Rerunning a level's narrowed critical cut (``--redo --pst-bracket``) over a record of both parts keeps
     the base run's speed, wall time, steps and commit, and takes the new search's cut, time and commit."""
-    base = {"dx": 0.0025, "precision": "float32", "level": 3, "note": "base run only (critical cut not bisected)",
-            "critical_cut": float("nan"), "speed": 22.0, "touchdown": 0.74, "collapse_height": 0.007,
-            "wall_time_s": 8000.0, "steps": 130000, "n_particles": 591360, "git_commit": "a"}
-    cut = {"dx": 0.0025, "precision": "float32", "level": 3, "part": "critical_cut", "critical_cut": 0.315625,
-           "critical_cut_bracket": [0.30625, 0.325], "bracketed": True, "critical_cut_note": "", "trials": [{}],
-           "critical_cut_wall_s": 3000.0, "critical_cut_steps": 100000, "bisection": {"lo": 0.30625},
-           "speed": float("nan"), "wall_time_s": 3000.0, "steps": 100000, "n_particles": 591360, "git_commit": "b"}
+    base, cut = _level_parts()
     both = merge_pst_parts(cut, base)
     again = {**cut, "critical_cut": 0.334375, "critical_cut_wall_s": 2500.0, "critical_cut_steps": 90000,
              "wall_time_s": 2500.0, "steps": 90000, "git_commit": "c"}
