@@ -101,8 +101,6 @@ def test_a_full_run_from_a_dirty_tree_is_refused_before_it_starts(monkeypatch, t
 # uncommitted changes, and rerunning them takes hours of CPU. This list may only shrink: rerun one from a
 # clean commit (the command beside it), commit the new JSON, and delete its line here.
 KNOWN_DIRTY = {
-    "convergence/results/error_vs_runtime_snow.json":
-        "python benchmarks/convergence/error_vs_runtime_snow.py",            # both ladders, hours
     "snow/results/snow_long_speed_trends.json": "python benchmarks/snow/long_speed_trends.py",   # hours
 }
 
