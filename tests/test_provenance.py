@@ -97,31 +97,19 @@ def test_a_full_run_from_a_dirty_tree_is_refused_before_it_starts(monkeypatch, t
     assert out_dir(argparse.Namespace(device="cpu", quick=False, out=str(tmp_path)), results) == str(tmp_path)
 
 
-# The committed results marked dirty when the guard was added (issue 37). Each was made by code with
-# uncommitted changes, and rerunning them takes hours of CPU. This list may only shrink: rerun one from a
-# clean commit (the command beside it), commit the new JSON, and delete its line here.
-KNOWN_DIRTY = {
-    "snow/results/snow_long_speed_trends.json": "python benchmarks/snow/long_speed_trends.py",   # hours
-}
-
-
-def test_no_new_committed_result_is_marked_dirty():
-    """No committed result may record uncommitted code (``+dirty`` or "uncommitted") unless it is in
-    ``KNOWN_DIRTY``, the explicit list of the ones that were dirty when this guard was added.
-
-    This test does not prove the committed results clean: the results in ``KNOWN_DIRTY`` are still
-    dirty until someone reruns them. It stops any new dirty result from landing, and it fails when a
-    listed one has been rerun clean but is still listed, so the list can only shrink.
-    """
+def _committed_results() -> dict[str, str]:
+    """Every committed result JSON (path under ``benchmarks/``: its text)."""
     files = glob.glob(os.path.join(ROOT, "benchmarks", "*", "results", "**", "*.json"), recursive=True)
     assert len(files) >= 30, "the committed results were not found"
-    dirty = set()
+    out = {}
     for path in files:
         with open(path) as fh:
-            text = fh.read()
-        if "+dirty" in text or "uncommitted" in text:
-            dirty.add(os.path.relpath(path, os.path.join(ROOT, "benchmarks")).replace(os.sep, "/"))
-    new = sorted(dirty - set(KNOWN_DIRTY))
-    assert not new, f"results from uncommitted code: {new}; rerun them from a clean commit"
-    rerun = sorted(set(KNOWN_DIRTY) - dirty)
-    assert not rerun, f"these are clean now: delete them from KNOWN_DIRTY: {rerun}"
+            out[os.path.relpath(path, os.path.join(ROOT, "benchmarks")).replace(os.sep, "/")] = fh.read()
+    return out
+
+
+def test_no_committed_result_is_marked_dirty():
+    """No committed result records uncommitted code (``+dirty`` or "uncommitted"): rerun it from a clean
+    commit (the tooling refuses to write one into the results, ``check_provenance``)."""
+    dirty = sorted(rel for rel, text in _committed_results().items() if "+dirty" in text or "uncommitted" in text)
+    assert not dirty, f"results from uncommitted code: {dirty}; rerun them from a clean commit"
