@@ -45,6 +45,8 @@ import numpy as np
 import warp as wp
 from helpers_scenes import TINY_PST  # tests/ is on the path: pytest's rootdir, or this script's folder
 
+from mpm_warp.studies.environment import check_provenance, git_commit
+
 #: architectures asked for (sm_70, sm_80, sm_90)
 REQUESTED_ARCHS = (70, 80, 90)
 
@@ -266,10 +268,11 @@ def compile_ptx(modules: dict, archs, out_dir: str, opt_level: int | None = None
 
 
 def environment() -> dict:
-    """Warp, its NVRTC, the machine and the date of a record."""
+    """The code (its commit), Warp, its NVRTC, the machine and the date of a record."""
     wp.init()
     tk = wp._src.context.runtime.toolkit_version
-    return {"warp": wp.__version__, "nvrtc_cuda_toolkit": ".".join(map(str, tk)) if tk else None,
+    return {"git_commit": git_commit(), "warp": wp.__version__,
+            "nvrtc_cuda_toolkit": ".".join(map(str, tk)) if tk else None,
             "cuda_driver": wp.is_cuda_available(), "python": platform.python_version(),
             "machine": platform.machine(), "cpus": os.cpu_count(),
             "load_average_1_5_15_min": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
@@ -351,6 +354,8 @@ def main(argv=None) -> int:
     ap.add_argument("--opt", type=int, default=None, help="NVRTC optimisation level (default: Warp's, 3)")
     ap.add_argument("--threads", type=int, default=2, help="modules compiled at a time")
     a = ap.parse_args(argv)
+    if a.record:  # uncommitted code's record is refused before the compile, not into the committed results
+        check_provenance(os.path.dirname(os.path.abspath(a.record)))
     wp.config.quiet = True
     os.makedirs(a.work, exist_ok=True)
     t0 = time.perf_counter()
