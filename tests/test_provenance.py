@@ -10,6 +10,7 @@ import argparse
 import glob
 import json
 import os
+import re
 import subprocess
 
 import pytest
@@ -113,3 +114,11 @@ def test_no_committed_result_is_marked_dirty():
     commit (the tooling refuses to write one into the results, ``check_provenance``)."""
     dirty = sorted(rel for rel, text in _committed_results().items() if "+dirty" in text or "uncommitted" in text)
     assert not dirty, f"results from uncommitted code: {dirty}; rerun them from a clean commit"
+
+
+def test_every_committed_result_names_the_commit_of_its_code():
+    """A result names the committed code that produced it: a whole commit hash under ``git_commit`` (or a
+    ``git_commit_*`` of a part run apart) somewhere in its JSON."""
+    unnamed = sorted(rel for rel, text in _committed_results().items()
+                     if not re.search(r'"git_commit(_[a-z_]+)?": "[0-9a-f]{40}', text))
+    assert not unnamed, f"results that do not name their code: {unnamed}; rerun them from a clean commit"
