@@ -50,7 +50,8 @@ def render_resolution(data: dict, ctx) -> list[str]:
                   "particles", "steps", "wall time (s)"], rows)
     same = [c["coarse"]["predicted"] == c["fine"]["predicted"] for c in cases]
     changes = [ch for ch in map(_change, cases) if ch is not None]
-    far = [f"`{c['test']}` {spct(ch)}" for c in cases if (ch := _change(c)) is not None and abs(ch) > CUT_SHARE]
+    far_cases = [c for c in cases if (ch := _change(c)) is not None and abs(ch) > CUT_SHARE]
+    far = [f"`{c['test']}` {spct(_change(c))}" for c in far_cases]
     moved = [f"`{c['test']}` ({c['observed']}): {c['coarse']['predicted']} -> {c['fine']['predicted']}"
              for c, s in zip(cases, same, strict=True) if not s]
     same_threads = [c["fine"]["wall_s"] / c["coarse"]["wall_s"] for c in cases
@@ -62,7 +63,6 @@ def render_resolution(data: dict, ctx) -> list[str]:
                        f"{len(changes) - len(far)} of {len(changes)}, from {spct(min(changes))} to "
                        f"{spct(max(changes))}" + (f"; apart: {', '.join(far)}" if far else "")
                        if changes else "no case ran away at both"), ""]
-    far_cases = [c for c in cases if (ch := _change(c)) is not None and abs(ch) > CUT_SHARE]
     if far_cases:
         parts, closer = [], []
         for c in far_cases:

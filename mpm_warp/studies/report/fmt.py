@@ -9,7 +9,7 @@ import math
 from collections.abc import Iterable, Sequence
 
 __all__ = ["finite", "fx", "pct", "spct", "count", "secs", "ratio_range", "span", "table", "env_note",
-           "environment_of", "bracket", "first", "check_line"]
+           "cases_load_note", "environment_of", "bracket", "first", "check_line"]
 
 DASH = "-"
 
@@ -124,6 +124,18 @@ def check_line(label: str, criterion: str, passed: bool | None, why: str = "") -
     """
     verdict = {True: "**pass**", False: "**FAIL**", None: "**open**"}[None if passed is None else bool(passed)]
     return f"- **Check, {label}:** {criterion}: {verdict}" + (f" ({why})" if why else "") + "."
+
+
+def cases_load_note(envs) -> str | None:
+    """The line on the load under a batch's cases: the 1-minute load average at their starts, from each case's own
+    environment record (None where none has one), beside :func:`env_note`'s load when the JSON was written."""
+    loads = sorted((e["load_average_1_5_15_min"][0], e.get("cpu_count")) for e in envs
+                   if e and e.get("load_average_1_5_15_min"))
+    if not loads:
+        return None
+    lo, hi, cores = loads[0][0], loads[-1][0], loads[0][1]
+    return (f"- The cases' wall times are upper bounds: the 1-minute load average at their starts was {lo:.1f}-"
+            f"{hi:.1f} on the {cores} cores (the note below: when the JSON was written).")
 
 
 def env_note(*records: dict, verb: str = "measured") -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ..convergence import loglog_slope
 from .core import section
-from .fmt import DASH, bracket, check_line, env_note, finite, fx, pct, secs, spct, table
+from .fmt import DASH, bracket, cases_load_note, check_line, env_note, finite, fx, pct, secs, spct, table
 
 
 def _column(data: dict) -> str:
@@ -169,12 +169,8 @@ def render_long_speed_trends(data: dict, ctx) -> list[str]:
                    f"{min(cases)[:16].replace('T', ' ')} and {max(cases)[:16].replace('T', ' ')} UTC"
                    + ("" if all(c.get("environment") for c in cases.values()) else
                       " (their load is not on record: the wall times are not from a quiet machine)") + ".")
-    envs = [c["environment"] for c in cases.values() if (c.get("environment") or {}).get("load_average_1_5_15_min")]
-    if envs:
-        lo, hi = min(e["load_average_1_5_15_min"][0] for e in envs), max(e["load_average_1_5_15_min"][0] for e in envs)
-        out.append(f"- The cases' wall times are upper bounds: the 1-minute load average at their starts was {lo:.1f}-"
-                   f"{hi:.1f} on the {envs[0].get('cpu_count')} cores (the note below: when the JSON was written).")
-    return out + ["", env_note(data)]
+    note = cases_load_note(c.get("environment") for c in cases.values())
+    return out + ([note] if note else []) + ["", env_note(data)]
 
 
 # ----------------------------------------------------------------------------- weac
