@@ -151,6 +151,40 @@ def test_lock_released_on_every_way_out(tmp_path):
     assert res.frames == 2
 
 
+#: a signal that raises (as the CLI's handler does before a run steps) arriving the moment the lock file exists
+SIGNAL_IN_ACQUIRE = r"""
+import os, signal, sys
+from mpm_warp.io import lock
+
+def stop(signum, frame):
+    raise KeyboardInterrupt
+signal.signal(signal.SIGTERM, stop)
+acquire = lock._acquire
+
+def acquire_then_signal(path):
+    fd = acquire(path)
+    os.kill(os.getpid(), signal.SIGTERM)  # the handler runs at the next chance Python gets
+    return fd
+lock._acquire = acquire_then_signal
+try:
+    with lock.output_lock(sys.argv[1]):
+        print("body ran")
+except KeyboardInterrupt:
+    print("interrupted")
+print("lock file left" if os.path.exists(lock.lock_path_for(sys.argv[1])) else "lock file removed")
+"""
+
+
+def test_a_signal_while_the_lock_is_taken_leaves_no_lock_file(tmp_path):
+    """SIGTERM arriving between the lock file's creation and the block that removes it (hit by a CLI run stopped
+    while it read its scenario, on a loaded machine): the signal waits until that block, which removes the file."""
+    out = tmp_path / "run.h5"
+    proc = subprocess.run([sys.executable, "-c", SIGNAL_IN_ACQUIRE, str(out)], capture_output=True, text=True,
+                          env=_env(), timeout=60)
+    assert proc.stdout.split("\n")[:2] == ["interrupted", "lock file removed"], proc.stdout + proc.stderr
+    assert not os.path.exists(io.lock.lock_path_for(out))
+
+
 def test_stale_lock_of_a_dead_run_is_taken_over_with_a_message(tmp_path, capsys):
     out = tmp_path / "run.h5"
     holder = _holder(out, "die")

@@ -17,7 +17,9 @@ import fcntl
 import json
 import logging
 import os
+import signal
 import socket
+import threading
 import time
 
 from ..errors import OutputError
@@ -30,6 +32,30 @@ log = logging.getLogger("mpm_warp")
 _HELD: dict[str, list] = {}
 #: a reader probing the lock holds it shared for microseconds: a writer retries this long before giving up (s)
 _RETRY_S = 0.25
+#: the signals that stop a command-line run (mpm_warp.stop)
+_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def _stop_signals_held():
+    """Record SIGINT/SIGTERM for the block instead of handling them; yields the list of those received.
+
+    Only the main thread runs Python's signal handlers (elsewhere the list stays empty); a handler Python did not
+    install (``getsignal`` None) is left as it is.
+    """
+    got: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield got
+        return
+    old = {sig: signal.getsignal(sig) for sig in _STOP_SIGNALS}
+    old = {sig: h for sig, h in old.items() if h is not None}
+    for sig in old:
+        signal.signal(sig, lambda signum, frame: got.append(signum))
+    try:
+        yield got
+    finally:
+        for sig, h in old.items():
+            signal.signal(sig, h)
 
 
 def lock_path_for(path) -> str:
@@ -121,25 +147,29 @@ def output_lock(path):
         finally:
             _HELD[key][1] -= 1
         return
-    fd = _acquire(path)
+    with _stop_signals_held() as held:         # a signal between the lock file's creation and the block that
+        fd = _acquire(path)                    # removes it would leave the file behind: it waits for that block
+        try:
+            old = _read_holder(fd)
+            if old:
+                log.warning("%s: taking over the stale lock of %s, which is no longer running", path,
+                            _describe(old))
+            me = {"pid": os.getpid(), "host": socket.gethostname(),
+                  "started": datetime.datetime.now().astimezone().isoformat(timespec="seconds")}
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, json.dumps(me).encode(), 0)
+            _HELD[key] = [fd, 1]
+        except BaseException as e:
+            with contextlib.suppress(OSError):
+                os.unlink(lock_path_for(path))
+            os.close(fd)
+            if isinstance(e, OSError) and not isinstance(e, OutputError):
+                raise OutputError(f"{path}: cannot write its lock file {lock_path_for(path)} ({e.strerror}); "
+                                  "nothing was written") from None
+            raise
     try:
-        old = _read_holder(fd)
-        if old:
-            log.warning("%s: taking over the stale lock of %s, which is no longer running", path, _describe(old))
-        me = {"pid": os.getpid(), "host": socket.gethostname(),
-              "started": datetime.datetime.now().astimezone().isoformat(timespec="seconds")}
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, json.dumps(me).encode(), 0)
-        _HELD[key] = [fd, 1]
-    except BaseException as e:
-        with contextlib.suppress(OSError):
-            os.unlink(lock_path_for(path))
-        os.close(fd)
-        if isinstance(e, OSError) and not isinstance(e, OutputError):
-            raise OutputError(f"{path}: cannot write its lock file {lock_path_for(path)} ({e.strerror}); nothing "
-                              "was written") from None
-        raise
-    try:
+        for signum in held:                    # delivered now, to the handlers of before
+            signal.raise_signal(signum)
         yield
     finally:
         del _HELD[key]
