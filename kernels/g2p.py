@@ -34,7 +34,8 @@ def _fma_options(dim):
     sums then as four-lane operations, ``kernels/g2p_rows.py``: 1.21 -> 0.92 ms).
     P2G keeps Warp's default: it evaluates the constitutive update, which must stay bit for bit
     the material-point driver's (``tests/test_constitutive.py``), and the compiler's fusion
-    choices depend on the code around the update. The 3D kernels keep the default too.
+    choices depend on the code around the update; only its 2D scatter fuses, inside its snippet
+    (``kernels/p2g_rows.py``). The 3D kernels keep the default too.
     """
     if dim != 2:
         return {}

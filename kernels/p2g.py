@@ -143,8 +143,8 @@ def p2g_kernel(dim, T, model, track_yield):
             s0 = strides[0] & NONNEG
             n0 = (b[0] * s0 + b[1] * strides[1]) & NONNEG
             # A dpos = A[:, 0] dpos_x + A[:, 1] dpos_y (Warp's order), its column terms formed once per stencil
-            # row and column: the same sums in the same order as the per-node product, bit for bit; the
-            # scatter as vector operations on the CPU (kernels/p2g_rows.py)
+            # row and column: the same sums in the same order as the per-node product; the scatter as
+            # vector operations with fused multiply-adds on the CPU (kernels/p2g_rows.py)
             scatter_rows(grid_m, grid_p, n0, s0, W, fx, dx, mass, mv, A)
         else:
             n0 = b[0] * strides[0] + b[1] * strides[1] + b[2]

@@ -5,9 +5,12 @@ node ``(a, c)``, with ``c_x,a = A[:, 0] (a - f_x) dx`` and ``c_y,c = A[:, 1] (c 
 MLS-MPM affine matrix; ``kernels/p2g.py``). The momenta of a row's nodes ``c = 0, 1`` are four adjacent
 numbers, added as one 4-vector; node 2's as a 2-vector. Warp's CPU code holds a 2-vector's lanes as
 scalars (and re-scalarizes a Warp 4-vector), with the compiler's vector types the scatter takes fewer
-instructions. Every product and sum is the Warp form's, in the same order, one per statement: P2G
-keeps the default contraction (within one expression), so no multiply-add is fused and the grid is the
-same bit for bit. On CUDA the snippet adds node by node with atomics, as Warp's ``+=`` does there.
+instructions. Every product and sum is the Warp form's, in the same order, one per statement; the CPU
+code lets the compiler fuse a product and the sum it feeds into one multiply-add (``#pragma clang fp
+contract(fast)``, local to the scatter: the rest of P2G, the constitutive update, keeps the default
+contraction), one rounding instead of two: the grid agrees with the Warp form to that rounding, and P2G
+is 4-8 % faster (16k-262k particles of the elastic block). On CUDA the snippet adds node by node with
+atomics, as Warp's ``+=`` does there.
 """
 
 import functools
@@ -63,6 +66,8 @@ def scatter_rows_func(T, portable=False):
         }}
     }}
 #else
+    {{
+#pragma clang fp contract(fast)
     typedef {s} v4 __attribute__((ext_vector_type(4)));
     typedef {s} v2 __attribute__((ext_vector_type(2)));
     {s}* gm = ({s}*)grid_m.data;
@@ -103,6 +108,7 @@ def scatter_rows_func(T, portable=False):
         __builtin_memcpy(&g2, gp + 2 * (na + 2), sizeof(g2));
         g2 = g2 + p2;
         __builtin_memcpy(gp + 2 * (na + 2), &g2, sizeof(g2));
+    }}
     }}
 #endif
 """

@@ -1,5 +1,6 @@
 """The native 2D transfer snippets (kernels/p2g_rows.py, kernels/g2p_rows.py): their CPU vector code against
-their plain code (CUDA's, built for the CPU with ``portable``) and against the Warp form they replace."""
+their plain code (CUDA's, built for the CPU with ``portable``) and against the Warp form they replace; both CPU
+snippets fuse multiply-adds, so they agree to rounding."""
 
 import numpy as np
 import pytest
@@ -104,11 +105,17 @@ def _gather(T, mode):
     return out.numpy()
 
 
-def test_scatter_vector_code_is_the_plain_code_and_the_warp_form_bit_for_bit(T):
+def test_scatter_vector_code_is_the_plain_code_to_the_rounding_of_its_fused_multiply_adds(T):
+    """CUDA's plain code and the Warp form give the same grid bit for bit; the CPU snippet fuses each product and
+    the sum it feeds (one rounding instead of two), so it agrees with them to a few rounding units of the grid's
+    values (a missed node or a wrong weight is off by a tenth of them)."""
     vec_m, vec_p = _scatter(T, "vector")
-    for mode in ("portable", "warp"):
-        m, p = _scatter(T, mode)
-        assert np.array_equal(vec_m, m) and np.array_equal(vec_p, p), mode
+    plain_m, plain_p = _scatter(T, "portable")
+    warp_m, warp_p = _scatter(T, "warp")
+    assert np.array_equal(plain_m, warp_m) and np.array_equal(plain_p, warp_p)
+    u = float(np.finfo(vec_m.dtype).eps)
+    assert np.abs(vec_m - plain_m).max() <= 8 * u * np.abs(plain_m).max()
+    assert np.abs(vec_p - plain_p).max() <= 8 * u * np.abs(plain_p).max()
     assert vec_m.sum() == pytest.approx(0.75 * 64, rel=1e-6)  # the weights of each particle sum to one
 
 
