@@ -151,6 +151,9 @@ def test_env_note_of_several_records_gives_ranges():
     assert env_note(a, b, old) == ("*Measured on cpu (x86_64, 2 cores), 2026-11-23 to 2026-12-02, load average 3.1-6.0 "
                                    "at the start and 2.5 at the end; warp 1.18.0, 1.19.0, Taichi 1.7.4.*")
     assert env_note({"device": "cpu"}) == "*Measured on cpu, date not recorded, load average not recorded.*"
+    zen4 = {"environment": {**ENV, "cpu_model": "AMD EPYC family 25 model 17 avx512f"}}
+    assert env_note(zen4, a).startswith("*Measured on cpu (x86_64, 2 cores; x86_64, AMD EPYC family 25 model 17 "
+                                        "avx512f, 2 cores), ")   # two hosts: the older record names no model
     assert spct(-0.0004) == "0.0 %" and spct(-0.081) == "-8.1 %"
 
 

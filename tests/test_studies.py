@@ -5,6 +5,7 @@ import argparse
 import json
 import math
 import os
+import re
 
 import numpy as np
 import pytest
@@ -211,6 +212,8 @@ def test_environment_record_is_written_with_the_load_at_the_end(tmp_path):
                 "h5py", "python", "git_commit"):
         assert key in env, key
     assert env["device"] == "cpu" and len(env["load_average_1_5_15_min"]) == 3
+    if os.path.exists("/proc/cpuinfo"):      # the host's CPU generation, e.g. "AMD EPYC family 25 model 17 avx512f"
+        assert re.fullmatch(r".+ family \d+ model \d+( avx512f)?", env["cpu_model"]), env["cpu_model"]
     path = write_json("r", {"environment": env, "x": np.float64(0.5)}, str(tmp_path / "out"))
     with open(path) as fh:
         back = json.load(fh)

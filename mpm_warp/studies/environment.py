@@ -46,6 +46,7 @@ def environment(device: str | None) -> dict:
         "load_average_1_5_15_min": list(os.getloadavg()),
         "git_commit": git_commit(),
         "cpu": platform.processor() or platform.machine(),
+        "cpu_model": cpu_model(),
         "cpu_count": os.cpu_count(),
         **versions(),
     }
@@ -54,6 +55,25 @@ def environment(device: str | None) -> dict:
     except importlib.metadata.PackageNotFoundError:  # optional: the peer of the throughput benchmarks
         env["taichi"] = None
     return env
+
+
+def cpu_model() -> str | None:
+    """The CPU's model name, family and model numbers and AVX-512 (Linux ``/proc/cpuinfo``; None elsewhere), e.g.
+    ``"AMD EPYC family 25 model 17 avx512f"``: runs on hosts of different CPU generations, which one ``cpu`` value
+    hides, then tell apart."""
+    try:
+        with open("/proc/cpuinfo") as fh:
+            info = dict(line.split(":", 1) for line in fh.read().split("\n\n")[0].splitlines() if ":" in line)
+    except (OSError, ValueError):
+        return None
+    info = {k.strip(): v.strip() for k, v in info.items()}
+    name = info.get("model name")
+    if not name:
+        return None
+    parts = [name, f"family {info['cpu family']}" if "cpu family" in info else "",
+             f"model {info['model']}" if "model" in info else "",
+             "avx512f" if "avx512f" in info.get("flags", "").split() else ""]
+    return " ".join(p for p in parts if p)
 
 
 def git_commit(path: str | None = None) -> str | None:

@@ -95,8 +95,9 @@ def table(header: Sequence[str], rows: Iterable[Sequence], align: Sequence[str] 
 def environment_of(data: dict) -> dict:
     """The environment record of a result, from its ``environment`` (or, in older files, its top-level keys).
 
-    Returns a dict with ``device``, ``cpu``, ``cpu_count``, ``date`` (``YYYY-MM-DD`` or None), ``load``
-    and ``load_end`` (1-minute load averages or None) and ``versions`` (name -> version, the peers that ran).
+    Returns a dict with ``device``, ``cpu``, ``cpu_model`` (None in older files), ``cpu_count``, ``date``
+    (``YYYY-MM-DD`` or None), ``load`` and ``load_end`` (1-minute load averages or None) and ``versions``
+    (name -> version, the peers that ran).
     """
     env = data.get("environment") if isinstance(data.get("environment"), dict) else {}
     versions = dict(data.get("versions") or {})
@@ -106,7 +107,8 @@ def environment_of(data: dict) -> dict:
     date = env.get("date") or data.get("date")
     load = env.get("load_average_1_5_15_min")
     load_end = env.get("load_average_at_end_1_5_15_min")
-    return {"device": env.get("device", data.get("device")), "cpu": env.get("cpu"), "cpu_count": env.get("cpu_count"),
+    return {"device": env.get("device", data.get("device")), "cpu": env.get("cpu"), "cpu_model": env.get("cpu_model"),
+            "cpu_count": env.get("cpu_count"),
             "date": date[:10] if isinstance(date, str) else None,
             "load": load[0] if load else None, "load_end": load_end[0] if load_end else None,
             "versions": versions}
@@ -146,7 +148,8 @@ def env_note(*records: dict, verb: str = "measured") -> str:
     """
     envs = [environment_of(r) for r in records]
     devices = sorted({e["device"] or "the host, no Warp device" for e in envs})
-    cpus = sorted({f"{e['cpu']}, {e['cpu_count']} cores" for e in envs if e["cpu"] and e["cpu_count"]})
+    cpus = sorted({f"{e['cpu']}, {e['cpu_model'] + ', ' if e['cpu_model'] else ''}{e['cpu_count']} cores"
+                   for e in envs if e["cpu"] and e["cpu_count"]})
     where = ", ".join(devices) + (f" ({'; '.join(cpus)})" if cpus else "")
     dates = sorted({e["date"] for e in envs if e["date"]})
     when = (dates[0] if len(dates) == 1 else f"{dates[0]} to {dates[-1]}") if dates else "date not recorded"
