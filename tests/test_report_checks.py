@@ -8,6 +8,7 @@ import re
 import pytest
 
 from mpm_warp.studies.report.fmt import check_line
+from mpm_warp.studies.report.perf import render_throughput
 from mpm_warp.studies.report.snowpack import ends_checks, outcome_checks
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -25,7 +26,8 @@ COMPARING = {"Error against run time: the reference problems": 2,
              "A resolved slab: the run and weac against a static FE": 4,
              "The rigid base: the same columns without their old snow": 2,
              "The pre-cut: the same columns started sawn": 2,
-             "The grid: the same columns at 6 cells across the weak layer": 2, "CUDA: the device suite": 3}
+             "The grid: the same columns at 6 cells across the weak layer": 2, "CUDA: the device suite": 3,
+             "Throughput beside Taichi, 2D": 1}
 LINE = re.compile(r"^- \*\*Check, [^*]+:\*\* .+: \*\*(pass|FAIL|open)\*\*( \(.+\))?\.$")
 
 
@@ -120,3 +122,22 @@ def test_the_layers_at_the_base_are_those_within_the_stencil_of_the_weak_layer()
     # thin layers: every base within 2 cells of the weak layer (the top one at 1.4), or all but the top one (2.2)
     assert _at_base({"layer_cells": [1.0, 0.7, 0.7]}) == {0, 1, 2}
     assert _at_base({"layer_cells": [1.0, 1.5, 0.7]}) == {1, 2}
+
+
+def test_the_2d_elastic_step_fails_its_target_at_the_size_where_it_falls_short():
+    """Issue 36's target: the 2D elastic step at least 1.2x Taichi at every size, one thread (wall clock)."""
+    def rows(ratios):
+        out = []
+        for n, r in zip((16384, 65536, 262144), ratios, strict=True):
+            out += [{"engine": "mpm_warp", "dim": 2, "material": "elastic", "n_particles": n, "threads": 1,
+                     "ratio_vs_taichi": r, "ratio_vs_taichi_cpu_time": r - 0.01},
+                    {"engine": "taichi", "dim": 2, "material": "elastic", "n_particles": n, "threads": 1}]
+        return {"rows": out, "environment": {"device": "cpu"}}
+
+    def check(ratios):
+        (line,) = [ln for ln in render_throughput(rows(ratios), None) if ln.startswith("- **Check")]
+        assert LINE.match(line), line
+        return line
+
+    assert check([1.48, 1.23, 1.09]).endswith("**FAIL** (1.09-1.48x wall clock, 1.08-1.47x CPU time).")
+    assert "**pass** (1.20-1.61x wall clock" in check([1.61, 1.36, 1.20])

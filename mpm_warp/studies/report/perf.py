@@ -7,9 +7,11 @@ import os
 from collections.abc import Sequence
 
 from .core import pending, section
-from .fmt import count, env_note, finite, fx, pct, ratio_range, secs, table
+from .fmt import check_line, count, env_note, finite, fx, pct, ratio_range, secs, table
 
 M = 1e-6   # particle-steps per second -> millions
+#: the 2D elastic step's throughput against Taichi's that a field season needs (its share of a field case's cost)
+ELASTIC_2D_TARGET = 1.2
 
 
 def _stem(source: str) -> str:
@@ -84,6 +86,15 @@ def render_throughput(data: dict, ctx) -> list[str]:
         if parts:
             out.append(f"- {dim}D, one thread: mpm_warp against Taichi in particle-steps per CPU second, "
                        + ", ".join(parts) + ".")
+    el2 = [r for r, _ in pairs if r["dim"] == 2 and r["material"] == "elastic" and r["threads"] == 1]
+    if el2:
+        wall = [r.get("ratio_vs_taichi") for r in el2]
+        cpu = [r.get("ratio_vs_taichi_cpu_time") for r in el2]
+        ok = all(finite(x) and x >= ELASTIC_2D_TARGET for x in wall)
+        out.append(check_line("the 2D elastic step against Taichi",
+                              f"at least {ELASTIC_2D_TARGET:g}x Taichi's particle-steps per second at every size, "
+                              "one thread", ok, f"{ratio_range(wall, 2)}x wall clock, {ratio_range(cpu, 2)}x "
+                              "CPU time"))
     multi = [(r, t) for r, t in pairs if r["threads"] > 1]
     if multi:
         out.append(f"- With {ratio_range([r['threads'] for r, _ in multi], 0)} threads mpm_warp used "
