@@ -47,8 +47,7 @@ def _stop_signals_held():
     if threading.current_thread() is not threading.main_thread():
         yield got
         return
-    old = {sig: signal.getsignal(sig) for sig in _STOP_SIGNALS}
-    old = {sig: h for sig, h in old.items() if h is not None}
+    old = {sig: h for sig in _STOP_SIGNALS if (h := signal.getsignal(sig)) is not None}
     for sig in old:
         signal.signal(sig, lambda signum, frame: got.append(signum))
     try:

@@ -63,10 +63,10 @@ def cpu_model() -> str | None:
     hides, then tell apart."""
     try:
         with open("/proc/cpuinfo") as fh:
-            info = dict(line.split(":", 1) for line in fh.read().split("\n\n")[0].splitlines() if ":" in line)
-    except (OSError, ValueError):
+            first = fh.read().split("\n\n")[0].splitlines()           # the first core's block
+    except OSError:
         return None
-    info = {k.strip(): v.strip() for k, v in info.items()}
+    info = {k.strip(): v.strip() for k, v in (line.split(":", 1) for line in first if ":" in line)}
     name = info.get("model name")
     if not name:
         return None

@@ -341,13 +341,12 @@ def _substratum(c: dict | None) -> list[str]:
     faster = (f"sets the time step in {c['substratum_sets_dt']} of {c['cases']} cases (by "
               f"{fx(c['c_p_over_slab_median_there'], 2)}x, median; up to {fx(c['c_p_over_slab_max'], 2)}x): those "
               "cases take that many more steps than their slab needs")
-    share = f"{pct(c['substratum_share_median'], 0)} of the column's height, median; {pct(lo, 0)}-{pct(hi, 0)}"
+    median, spread = f"{pct(c['substratum_share_median'], 0)} of the column's height", f"{pct(lo, 0)}-{pct(hi, 0)}"
     rigid = c.get("rigid_base", 0)
     if rigid and rigid == c["cases"]:
         who = " and ".join(m.replace("_", " ") for m in c.get("faster_materials", [])) or "another material"
         return ["", "- **The column's cost beside the crack:** every run stands on a rigid base, so the profile's "
-                f"snow below the weak layer ({share}) is not run. A material faster than the slab (its P-wave speed; "
-                f"here the {who}) {faster}."]
+                f"snow below the weak layer ({median}, median; {spread}) is not run. A material faster than the slab "
+                f"(its P-wave speed; here the {who}) {faster}."]
     return ["", f"- **The column's cost beside the crack:** the substratum (the profile's snow below the weak layer, "
-            f"docs/profiles.md) is {share.replace(', median;', ' (median;')}), and its P-wave speed, above the slab's, "
-            f"{faster}."]
+            f"docs/profiles.md) is {median} (median; {spread}), and its P-wave speed, above the slab's, {faster}."]
