@@ -23,7 +23,8 @@ def cmd_field(a) -> int:
 
     res = run_field(a.inputs, a.out, workers=a.workers, scheduler=a.scheduler, device=a.device, limit=a.limit,
                     protocol=FieldProtocol(max_particles=a.max_particles, threads=a.threads,
-                                           rigid_base=not a.elastic_substratum, pre_cut_share=a.pre_cut_share),
+                                           rigid_base=not a.elastic_substratum, pre_cut_share=a.pre_cut_share,
+                                           interface_closure=a.interface_closure),
                     progress=not a.quiet)
     sc = res.scores
 
@@ -60,5 +61,7 @@ def add_field(sub) -> None:
                    help="run the weak layer on the profile's old snow instead of a rigid base (weac's column)")
     p.add_argument("--pre-cut-share", type=float, default=FieldProtocol.pre_cut_share, metavar="SHARE",
                    help="start each column sawn this share of weac's critical cut, in [0, 0.9] (default 0.5; 0: none)")
+    p.add_argument("--interface-closure", action="store_true",
+                   help="run each column with the laminate closure at its layer interfaces (docs/model.md §5b)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_field)

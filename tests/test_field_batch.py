@@ -139,6 +139,26 @@ def test_the_protocol_runs_the_weak_layer_on_a_rigid_base_and_keys_its_cache_by_
         FieldProtocol(rigid_base=1).validate()
 
 
+def test_a_protocol_with_the_interface_closure_runs_it_and_keeps_the_keys_of_cases_run_without(tmp_path):
+    """The closure is a scene option the protocol passes on; off, the key is the one cases had before the option
+    existed (a batch resumes them), on, a key of its own."""
+    from mpm_warp.field.batch import case_digest
+    from mpm_warp.field.protocol import protocol_params
+
+    table = tmp_path / "psts.csv"
+    table.write_text(TABLE)
+    cases, _ = gather([str(table)], calibrate=False)
+    closed = FieldProtocol(interface_closure=True)
+    p, _, note = protocol_params(cases[0].params, closed)
+    assert p.interface_closure and p.rigid_base and note.endswith(", on a rigid base, laminate closure")
+    assert not protocol_params(cases[0].params, FieldProtocol())[0].interface_closure
+    assert "interface_closure" not in FieldProtocol().run_key()
+    assert closed.run_key() == {**FieldProtocol().run_key(), "interface_closure": True}
+    assert case_digest(cases[0], closed) != case_digest(cases[0], FieldProtocol())
+    with pytest.raises(Exception, match="interface_closure = 1"):
+        FieldProtocol(interface_closure=1).validate()
+
+
 def test_a_protocol_with_a_pre_cut_starts_each_column_sawn_a_share_of_weacs_critical_cut(tmp_path):
     from mpm_warp.field.batch import _case_id
     from mpm_warp.field.protocol import protocol_params

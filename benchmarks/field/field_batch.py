@@ -75,6 +75,8 @@ def main(argv=None) -> int:
                    help="run the weak layer on the profile's old snow instead of a rigid base (weac's column)")
     p.add_argument("--pre-cut-share", type=float, default=FieldProtocol.pre_cut_share,
                    help="start each column sawn this share of weac's critical cut (default 0.5; 0: none)")
+    p.add_argument("--interface-closure", action="store_true",
+                   help="run each column with the laminate closure at its layer interfaces (docs/model.md §5b)")
     p.add_argument("--no-measured", action="store_true",
                    help="leave out the measured-density columns (a first, small sample: the stratified part only)")
     args = p.parse_args(argv)
@@ -89,7 +91,7 @@ def main(argv=None) -> int:
     env = environment(args.device)
     t1 = time.perf_counter()
     proto = FieldProtocol(max_particles=budget, threads=args.threads, rigid_base=not args.elastic_substratum,
-                          pre_cut_share=args.pre_cut_share).validate()
+                          pre_cut_share=args.pre_cut_share, interface_closure=args.interface_closure).validate()
     if args.finished_only:
         recs = finished_records(chosen, runs, proto)
         batch = FieldBatch(recs, [], score_records(recs), len(recs), runs)

@@ -39,7 +39,8 @@ from .static_rule import weac_static_class
 from .table import table_profiles
 from .uncertainty import balanced_accuracy_intervals
 
-__all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "run_records", "FieldBatch"]
+__all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "run_records", "case_digest",
+           "FieldBatch"]
 
 
 @dataclass
@@ -80,11 +81,16 @@ def gather(inputs, calibrate: bool = True) -> tuple[list[FieldCase], list[FieldR
     return cases, refused
 
 
+def case_digest(case: FieldCase, proto: FieldProtocol) -> str:
+    """The key of ``case`` run under ``proto``: 12 hex digits of a digest of its parameters and the protocol (the
+    last part of its id; the same case set up again from its pit gets the same)."""
+    key = {"case": case.params.to_dict(), "protocol": proto.run_key()}
+    return hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()[:12]
+
+
 def _case_id(case: FieldCase, k: int, proto: FieldProtocol) -> str:
     stem = os.path.splitext(case.pit)[0].replace("#", "-").replace(" ", "_")
-    key = {"case": case.params.to_dict(), "protocol": proto.run_key()}
-    digest = hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()
-    return f"{stem}-{k}-{digest[:12]}"
+    return f"{stem}-{k}-{case_digest(case, proto)}"
 
 
 def _write_json(path: str, obj: dict) -> None:

@@ -49,6 +49,9 @@ class FieldProtocol:
         The saw's pre-cut (``scene.saw.pre_cut``) as a share of weac's critical cut of the column at its fracture
         energy, in [0, 0.9]: the column starts sawn that far, sparing the simulated time of sawing it (0.5, the
         default: docs/field.md); 0: the saw cuts from the end.
+    interface_closure : bool
+        Run the column with the laminate closure at its layer interfaces (``scene.interface_closure``,
+        docs/model.md §5b), or without it (False, the default).
     threads : int
         CPU threads each case's step runs on (the CPU step's own threads; ignored on CUDA). A batch's workers
         times this should not exceed the cores: on 2 cores, 1 worker of 2 threads finishes each case sooner
@@ -62,6 +65,7 @@ class FieldProtocol:
     frame_interval: float = 0.005
     rigid_base: bool = True
     pre_cut_share: float = 0.5
+    interface_closure: bool = False
     threads: int = 1
 
     def validate(self) -> FieldProtocol:
@@ -74,16 +78,20 @@ class FieldProtocol:
         finite_number("tail", self.tail, lo=0.0)
         finite_number("frame_interval", self.frame_interval, lo=0.0, lo_open=True, hi=0.1)
         positive_int("threads", self.threads, lo=1, hi=64)
-        if not isinstance(self.rigid_base, bool):
-            raise InvalidArgument("rigid_base", self.rigid_base, "true or false")
+        for name in ("rigid_base", "interface_closure"):
+            if not isinstance(getattr(self, name), bool):
+                raise InvalidArgument(name, getattr(self, name), "true or false")
         finite_number("pre_cut_share", self.pre_cut_share, lo=0.0, hi=0.9)
         return self
 
     def run_key(self) -> dict:
         """The fields that change what a case computes (all but ``threads``): a cached case is reused only under
-        the same ones."""
+        the same ones. ``interface_closure`` is left out while off, so that the cases run before it existed keep
+        their keys."""
         d = dataclasses.asdict(self)
         del d["threads"]
+        if not self.interface_closure:
+            del d["interface_closure"]
         return d
 
 
@@ -101,6 +109,8 @@ def protocol_params(params: PSTParams, proto: FieldProtocol, static_cut: float |
     ``static_cut`` is weac's critical cut of the column (m; None: not critical, or not asked for), the pre-cut's
     measure when the protocol has one.
     """
+    if proto.interface_closure:
+        params = dataclasses.replace(params, interface_closure=True)
     if proto.rigid_base:
         bare = PSTParams()
         params = dataclasses.replace(params, rigid_base=True, substratum_layers=(), substratum=bare.substratum,
@@ -118,6 +128,7 @@ def protocol_params(params: PSTParams, proto: FieldProtocol, static_cut: float |
             end = p.saw_start + (p.length - p.saw.pre_cut) / proto.saw_speed + proto.tail
             note = (f"{cells} cells across the weak layer, dx {dx * 1e3:.2f} mm, about {n:,} particles"
                     + (", on a rigid base" if proto.rigid_base else "")
+                    + (", laminate closure" if proto.interface_closure else "")
                     + (f", pre-cut {p.saw.pre_cut * 100:.1f} cm" if p.saw.pre_cut > 0.0 else ""))
             return p.validate("scene"), TimeControl(end=end, frame_interval=proto.frame_interval), note
     return None, None, (f"the column is too large for the per-case budget: {n:,} particles at the coarsest grid "
