@@ -15,10 +15,13 @@ import warp as wp
 from .errors import SimulationBlowUp
 from .kernels.diagnostics import INT_MAX, health_kernel, health_zz_kernel
 
-__all__ = ["MAX_CELLS_PER_STEP", "check_health"]
+__all__ = ["MAX_CELLS_PER_STEP", "MIN_DT_SHARE", "check_health"]
 
 #: a particle may not move more than this many cells in one step (health check)
 MAX_CELLS_PER_STEP = 1.0
+#: a step below this share of the elastic step (``cfl dx / c_p``) means a nodal speed a million times the
+#: P-wave speed, or a non-finite one: the run stops instead of crawling (or, at a step of 0, never ending)
+MIN_DT_SHARE = 1e-6
 
 
 def check_health(sim, bad: wp.array) -> None:

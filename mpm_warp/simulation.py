@@ -19,7 +19,7 @@ from . import checks, frames, io, snapshot
 from .config import Scenario
 from .device import resolve_device
 from .errors import InvalidArgument, MPMError, SimulationBlowUp
-from .health import MAX_CELLS_PER_STEP, check_health  # noqa: F401
+from .health import MAX_CELLS_PER_STEP, MIN_DT_SHARE, check_health  # noqa: F401
 from .kernels.diagnostics import INT_MAX, energy_kernel, health_kernel, health_zz_kernel, stress_kernel  # noqa: F401
 from .memory import check_memory
 from .model import Model, ParticleGroup, State, material_params
@@ -216,12 +216,19 @@ class Simulation:
             if self.stepper.use_graph:
                 n = self.stepper.graph_batch  # one captured graph; the steps past t_end are no-ops (dt = 0)
             self.stepper.steps(n)
+            t_before, steps_before = t, steps0 + taken
             t, dt_new, steps = self.stepper.clock()
             taken = steps - steps0
             self._since_health += n
             if self._since_health >= he:
                 self.health()
                 self._since_health = 0
+            if t < t_end * (1 - 1e-12) - 1e-15 and (steps == steps_before or t == t_before
+                                                    or not dt_new >= MIN_DT_SHARE * self._first_dt()):
+                raise SimulationBlowUp(steps, -1, "dt", (
+                    f"the time step fell to {dt_new:.3g} s at t = {t:.6g} s, below {MIN_DT_SHARE:g} of the elastic "
+                    f"step ({self._first_dt():.3g} s): the largest nodal speed is not finite or beyond any physical "
+                    "one (the state diverged)"))
             dt = dt_new if dt_new > 0 else dt
             if self._stop_now:
                 break

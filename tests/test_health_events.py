@@ -56,3 +56,26 @@ def test_on_inversion_travels_with_the_scenario():
     assert sc.output.on_inversion == "stop"
     assert resolved_scenario(sc.to_dict()).output.on_inversion == "stop"
     assert mw.load_scenario("elastic_block").output.on_inversion == "report"
+
+
+@pytest.mark.parametrize("speed", [float("inf"), float("nan")])
+def test_a_step_size_that_falls_to_zero_stops_the_run_instead_of_hanging(speed):
+    """A nodal speed that overflows (a diverged field column did) makes the automatic step 0: every later step was a
+    no-op and the run never ended (this test hung before). Now it stops at once with one line."""
+    sc = mw.load_scenario("elastic_block", ["time.end=0.03", "time.frame_interval=0.01", "output.health_every=5"])
+    sim = mw.Simulation(sc, device="cpu")
+    sim.stepper.vmax.fill_(speed)                   # the largest nodal speed of the previous step
+    with pytest.raises(mw.SimulationBlowUp) as info:
+        sim.run(None)
+    e = info.value
+    assert (e.field, e.step, e.particle) == ("dt", 0, -1)
+    assert str(e).startswith("simulation stopped at step 0: field 'dt': the time step fell to ")
+    assert "below 1e-06 of the elastic step (0.000109 s): the largest nodal speed is not finite" in str(e)
+
+
+def test_a_fast_first_step_that_recovers_is_not_stopped():
+    """A huge speed bound makes one tiny step; the next takes the real nodal speeds again, and the run goes on."""
+    sc = mw.load_scenario("elastic_block", ["time.end=0.03", "time.frame_interval=0.01", "output.health_every=5"])
+    sim = mw.Simulation(sc, device="cpu")
+    sim.stepper.vmax.fill_(1.0e12)
+    assert sim.run(None).sim_time == pytest.approx(0.03)
