@@ -97,6 +97,7 @@ def main(argv=None) -> int:
         return 2
     setup_s = time.perf_counter() - t0
     dest = out_dir(args, RESULTS, "field_closure")
+    env = environment("cpu")
     with tempfile.TemporaryDirectory(prefix="mpm_warp_closure_") as tmp:
         runs = args.runs or tmp
         batch = run_cases(cases, [], runs, workers=args.workers, protocol=on)
@@ -113,7 +114,7 @@ def main(argv=None) -> int:
                       f"finished cases of the batches whose run took at most {cap:g} s",
             "runs": os.path.basename(os.path.normpath(args.runs)) if args.runs else None,
             "protocol": on.run_key(), "threads": args.threads, "workers": args.workers, "setup_s": setup_s,
-            "environment": environment("cpu"), "cases": rows}
+            "environment": env, "cases": rows}
     path = write_json("field_closure", data, dest)
     print(f"{path}: {len(rows)} cases")
     return 0

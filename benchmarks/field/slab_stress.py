@@ -16,8 +16,8 @@ long as the slab is deep. Nothing here changes the model. Writes
 ``benchmarks/field/results/field_slab_stress.json``.
 
 Usage: ``python benchmarks/field/slab_stress.py RUNDIR [RUNDIR ...] [--observed SF --predicted END]
-[--sample N --seed 0] [--cases ID ...] [--no-control]``; ``--quick``: the first selected case, to a temporary
-folder. Minutes of CPU a case.
+[--sample N --seed 0] [--cases ID ...] [--no-control] [--interface-closure on|off]``; ``--quick``: the first
+selected case, to a temporary folder. Minutes of CPU a case.
 """
 
 from __future__ import annotations
@@ -141,9 +141,12 @@ def mpm_ratio_to(series: dict, cut: float) -> float | None:
     return max(r) if r else None
 
 
-def case_row(rec: dict, run_dir: str, tmp: str, threads: int) -> dict:
+def case_row(rec: dict, run_dir: str, tmp: str, threads: int, closure: bool | None = None) -> dict:
     ck = os.path.join(run_dir, rec["id"] + ".ckpt.h5")
     sc = resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck)
+    if closure is not None and closure != sc.scene.interface_closure:      # the same column, the closure switched
+        sc = build(dataclasses.replace(sc.scene, interface_closure=closure),
+                   TimeControl(end=sc.time.end, frame_interval=sc.time.frame_interval), name="field")
     p = sc.scene
     out = run_series(sc, os.path.join(tmp, rec["id"] + ".h5"), threads)
     s, onset = out["series"], onset_cut(out["series"], p.dx)
@@ -153,7 +156,8 @@ def case_row(rec: dict, run_dir: str, tmp: str, threads: int) -> dict:
     peak_frame = int(np.argmax([max(row) for row in s["ratio"]]))
     return {"id": rec["id"], "test": rec["test"], "observed": rec["observed"], "predicted_batch": rec["predicted"],
             "peak_at": s["peak_at"][peak_frame],
-            "predicted": out["predicted"], "slope_deg": p.slope_angle, "dx": p.dx, "slab_depth_m": p.slab_depth,
+            "predicted": out["predicted"], "interface_closure": p.interface_closure,
+            "slope_deg": p.slope_angle, "dx": p.dx, "slab_depth_m": p.slab_depth,
             "recorded_cut": rec["recorded_cut"],
             "onset_cut": onset, "runaway_cut": rec.get("runaway_cut"), "layers": layers,
             "mpm_peak_ratio": max(max(row) for row in s["ratio"]),
@@ -174,7 +178,10 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=0, help="seed of --sample (default 0)")
     p.add_argument("--no-control", action="store_true", help="leave out the homogeneous control")
     p.add_argument("--threads", type=int, default=1, help="CPU threads of each run (default 1)")
+    p.add_argument("--interface-closure", choices=("as-run", "on", "off"), default="as-run",
+                   help="run each column with the laminate closure on or off (default: as its batch ran it)")
     args = p.parse_args(argv)
+    closure = None if args.interface_closure == "as-run" else args.interface_closure == "on"
     warnings.filterwarnings("ignore")
     recs = [(r, run_dir) for r, run_dir in run_records(args.runs)
             if ((r["id"] in args.cases) if args.cases else
@@ -187,7 +194,8 @@ def main(argv=None) -> int:
     data = {"name": "field_slab_stress", "runs": [os.path.basename(os.path.normpath(d)) for d in args.runs],
             "onset_cells": ONSET_CELLS, "selection": {"cases": args.cases} if args.cases else {
                 "observed": args.observed, "predicted": args.predicted, "sample": args.sample, "seed": args.seed},
-            "selected": len(recs), "environment": environment("cpu"), "cases": []}
+            "interface_closure": args.interface_closure, "selected": len(recs), "environment": environment("cpu"),
+            "cases": []}
     with tempfile.TemporaryDirectory(prefix="mpm_warp_slab_stress_") as tmp:
         if not args.no_control:
             data["control"] = control(tmp, args.threads)
@@ -195,7 +203,7 @@ def main(argv=None) -> int:
                                           for r in data["control"]["rows"]), flush=True)
             path = write_json("field_slab_stress", data, dest)
         for r, run_dir in recs:
-            row = case_row(r, run_dir, tmp, args.threads)
+            row = case_row(r, run_dir, tmp, args.threads, closure)
             data["cases"].append(row)
             path = write_json("field_slab_stress", data, dest)          # after every case
             print(f"{r['test']}: MPM peak {row['mpm_peak_ratio']:.2f} of strength; weac at the recorded cut "

@@ -33,6 +33,7 @@ import sys
 from . import (  # noqa: F401
     convergence,
     field,
+    field_closure,
     field_pre_cut,
     field_resolution,
     field_rigid_base,
