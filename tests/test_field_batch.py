@@ -190,3 +190,19 @@ def test_the_pre_cut_is_measured_on_weacs_critical_cut_of_the_column(tmp_path):
     a = _static_cut(cases[0])
     assert 0.0 < a < 0.4
     assert energy_release_rate(static_column(cases[0].params), a)[0] == pytest.approx(0.3, rel=0.02)   # w_f given
+
+
+def test_a_protocol_with_the_closure_refuses_a_column_with_a_layer_thinner_than_a_cell_in_field_terms(tmp_path):
+    from mpm_warp.field.batch import _tasks
+
+    (tmp_path / "slab.csv").write_text("thickness_cm,density\n0.5,250\n14.5,180\n")
+    table = tmp_path / "psts.csv"
+    table.write_text("id,outcome,slope_deg,column_cm,cut_cm,layers,weak_layer_cm,w_f\n"
+                     "crust,End,0,40,12,slab.csv,4,0.3\n")
+    cases, _ = gather([str(table)], calibrate=False)
+    refused = []
+    assert _tasks(cases, str(tmp_path), FieldProtocol(interface_closure=True), "cpu", refused) == []
+    (r,) = refused
+    assert r.reason == "thin layer" and r.message == (
+        "the laminate closure needs every layer at least a grid cell thick, and slab layer 1 (from the top) is 5.0 "
+        "mm, under the 10.00 mm cell the weak layer sets: run this column without --interface-closure")

@@ -149,3 +149,20 @@ def test_a_homogeneous_stack_is_left_alone():
     assert 0 < band.sum() <= 8 and np.all(np.abs(y[band] - 0.1033) < 2.0 * dx)
     np.testing.assert_allclose(fac[:, :2], 1.0, rtol=1e-12)
     np.testing.assert_allclose(fac[:, 2], 0.0, atol=1e-12)
+
+
+def test_the_closure_refuses_a_layer_thinner_than_a_grid_cell():
+    """A field column whose slab held two 4 mm layers at dx 9 mm diverged with the closure in its first frame, where
+    it ran without it (docs/model.md §5b): the closure smears each cell's compliance over layers at least a cell
+    thick, and a thinner one is refused in one line."""
+    from mpm_warp.scenes.pst import PSTParams
+    from mpm_warp.scenes.snowpack import SnowLayer
+
+    p = PSTParams(slab_layers=(SnowLayer(0.15, 150.0), SnowLayer(0.004, 290.0), SnowLayer(0.15, 210.0)))
+    assert p.validate("scene") is p
+    with pytest.raises(InvalidArgument) as info:
+        dataclasses.replace(p, interface_closure=True).validate("scene")
+    assert str(info.value) == ("scene.interface_closure = True is invalid: expected false where a layer is thinner "
+                               f"than a grid cell ({p.dx * 1e3:.2f} mm): slab layer 2 (from the top) is 4.0 mm")
+    thick = dataclasses.replace(p, slab_layers=(SnowLayer(0.15, 150.0), SnowLayer(p.dx, 290.0)), interface_closure=True)
+    assert thick.validate("scene").interface_closure

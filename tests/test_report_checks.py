@@ -27,7 +27,9 @@ COMPARING = {"Error against run time: the reference problems": 2,
              "The rigid base: the same columns without their old snow": 2,
              "The pre-cut: the same columns started sawn": 2,
              "The grid: the same columns at 6 cells across the weak layer": 2, "CUDA: the device suite": 3,
-             "Throughput beside Taichi, 2D": 1}
+             "Throughput beside Taichi, 2D": 1,
+             "The laminate closure: the same columns without and with it": 2,
+             "The laminate closure: the slab's stress at the weak layer against the FE": 2}
 LINE = re.compile(r"^- \*\*Check, [^*]+:\*\* .+: \*\*(pass|FAIL|open)\*\*( \(.+\))?\.$")
 
 
@@ -141,3 +143,18 @@ def test_the_2d_elastic_step_fails_its_target_at_the_size_where_it_falls_short()
 
     assert check([1.48, 1.23, 1.09]).endswith("**FAIL** (1.09-1.48x wall clock, 1.08-1.47x CPU time).")
     assert "**pass** (1.20-1.61x wall clock" in check([1.61, 1.36, 1.20])
+
+
+def test_a_section_that_follows_another_lands_after_it_whichever_is_registered_first(monkeypatch, tmp_path):
+    from mpm_warp.errors import InvalidArgument
+    from mpm_warp.studies.report import core
+
+    monkeypatch.setattr(core, "SECTIONS", [])
+    monkeypatch.setattr(core, "_WAITING", {})
+    for title, follows in (("a", None), ("c", "b"), ("b", "a"), ("d", None), ("e", "a")):
+        core.section("field", title, f"{title}.json", "cmd", follows=follows)(lambda data, ctx: [])
+    assert [s.title for s in core.SECTIONS] == ["a", "e", "b", "c", "d"]
+    core.section("field", "f", "f.json", "cmd", follows="nowhere")(lambda data, ctx: [])
+    (tmp_path / "benchmarks").mkdir()
+    with pytest.raises(InvalidArgument, match="follows"):
+        core.document(core.Context(str(tmp_path)))

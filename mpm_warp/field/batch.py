@@ -178,14 +178,14 @@ def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
 
     tasks = []
     for k, c in enumerate(cases):
-        params, tc, note = protocol_params(c.params, proto, _static_cut(c) if proto.pre_cut_share > 0.0 else None)
-        if params is None:
-            refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
-            continue
         try:
+            params, tc, note = protocol_params(c.params, proto, _static_cut(c) if proto.pre_cut_share > 0.0 else None)
+            if params is None:
+                refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
+                continue
             scenario = build(params, tc, name="field")          # calibrates the weak layer (once per column)
         except InvalidArgument as e:
-            refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, params), c.outcome))
+            refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, c.params), c.outcome))
             continue
         wf = c.fracture_energy
         tasks.append({"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),

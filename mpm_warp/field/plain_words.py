@@ -53,6 +53,11 @@ def in_field_terms(e: InvalidArgument, params) -> tuple[str, str]:
     if field in ("h_c", "xi", "sigma_n"):
         return "collapse", (f"{load} crushes the weak layer before any cut (its strength in compression is below "
                             "the load): the model's weak layer cannot carry it")
+    if field.endswith(".interface_closure"):
+        cell, _, thin = str(getattr(e, "allowed", "")).partition("): ")
+        return "thin layer", (f"the laminate closure needs every layer at least a grid cell thick, and {thin}, under "
+                              f"the {cell.rsplit('(', 1)[-1]} cell the weak layer sets: run this column without "
+                              "--interface-closure")
     if field.endswith(".dx"):
         return "grid", (f"the slab's snow is too brittle for the grid the {params.weak_layer_thickness * 100:.2g} cm "
                         "weak layer sets (its crack band would be wider than the snow's fracture length)")

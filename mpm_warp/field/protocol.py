@@ -10,6 +10,8 @@
   (``pre_cut_share``), as a slow saw would leave it; the blade goes on from there.
 - **The base**: the weak layer lies on a rigid base (``scene.rigid_base``), the column that weac reads the
   fracture energy back with; the old snow under it is left out (docs/field.md, "The field protocol").
+- **The interfaces** (optional, off by default): the laminate closure (``interface_closure``, docs/model.md §5b)
+  at the column's layer interfaces.
 - **The run** lasts the settling, the saw's way to the end, and :attr:`FieldProtocol.tail` after it, and stops
   at the first frame at which the outcome is decided (END, SF, an arrest after a runaway, no propagation).
 """

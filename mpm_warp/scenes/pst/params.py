@@ -148,6 +148,8 @@ class PSTParams:
             self._check_crack_band(where)
         if not isinstance(self.interface_closure, bool):
             raise InvalidArgument(f"{where}.interface_closure", self.interface_closure, "true or false")
+        if self.interface_closure:
+            self._check_closure_layers(where)
         finite_number(f"{where}.slope_angle", self.slope_angle, lo=-60.0, hi=60.0)
         finite_number(f"{where}.width", self.width, lo=0.0)
         check_plane_strain(self.plane_strain, self.width, where)
@@ -169,6 +171,17 @@ class PSTParams:
             raise InvalidArgument(f"{where}.length", self.length, f"a number in ({zone:g}, inf) with a saw cut: longer "
                                   "than the far end zone, one slab depth, where a front counts as at the far end")
         return self
+
+    def _check_closure_layers(self, where: str) -> None:
+        """The laminate closure smears each grid cell's compliance over layers at least a cell thick (docs/model.md
+        §5b); a thinner one diverged on a field column: refuse it."""
+        stack = [("slab", k, ly.thickness) for k, ly in enumerate(self.slab_stack())]
+        stack += [("substratum", k, ly.thickness) for k, ly in enumerate(self.substratum_stack())]
+        for part, k, t in stack:
+            if t < self.dx:
+                raise InvalidArgument(f"{where}.interface_closure", True, (
+                    f"false where a layer is thinner than a grid cell ({self.dx * 1e3:.2f} mm): {part} layer {k + 1} "
+                    f"(from the top) is {t * 1e3:.1f} mm"))
 
     def _check_layers(self, part: str, where: str) -> None:
         """Check ``{part}_layers``; refuse them beside a ``{part}``/``{part}_thickness`` that is not the default."""

@@ -62,15 +62,35 @@ class Section:
 SECTIONS: list[Section] = []
 
 
-def section(part: str, title: str, source: str, command, figure: str | None = None, question: str = ""):
-    """Decorator registering ``render(data, ctx) -> list[str]`` as the section of ``source`` (see :class:`Section`)."""
+def section(part: str, title: str, source: str, command, figure: str | None = None, question: str = "",
+            follows: str | None = None):
+    """Decorator registering ``render(data, ctx) -> list[str]`` as the section of ``source`` (see :class:`Section`);
+    ``follows``: the title of the section this one comes right after, registered before or after it (else it
+    comes last)."""
     if part not in PARTS:
         raise InvalidArgument("part", part, f"one of {sorted(PARTS)}")
 
     def register(render):
-        SECTIONS.append(Section(part, title, source, command, render, figure, question))
+        _place(Section(part, title, source, command, render, figure, question), follows)
         return render
     return register
+
+
+#: sections waiting for the one they follow to be registered: its title -> them
+_WAITING: dict[str, list[Section]] = {}
+
+
+def _place(sec: Section, follows: str | None) -> None:
+    titles = [s.title for s in SECTIONS]
+    if follows is None:
+        SECTIONS.append(sec)
+    elif follows in titles:
+        SECTIONS.insert(titles.index(follows) + 1, sec)
+    else:
+        _WAITING.setdefault(follows, []).append(sec)
+        return
+    for waiting in reversed(_WAITING.pop(sec.title, [])):
+        _place(waiting, sec.title)
 
 
 def pending(part: str, title: str, source: str, command: str, question: str = "") -> None:
@@ -165,6 +185,8 @@ script asks and how long it runs is in [`benchmarks/README.md`](../benchmarks/RE
 
 def document(ctx: Context, sections: list[Section] | None = None) -> str:
     """The whole results document (Markdown) from the registered sections (or ``sections``)."""
+    if _WAITING:
+        raise InvalidArgument("follows", sorted(_WAITING), "titles of registered sections")
     sections = SECTIONS if sections is None else sections
     out = [HEAD]
     devices = sorted({str(environment_of(ctx.load(s.source))["device"] or "")

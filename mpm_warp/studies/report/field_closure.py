@@ -32,7 +32,8 @@ def _balanced(cases: list, side: str) -> tuple[float | None, dict]:
                    f"--threads {d['threads']}",
          question="Does a field case keep its class, and its runaway cut, when its column runs with the laminate "
                   "closure at its layer interfaces (docs/model.md §5b), which removes the grid's bimaterial artefact "
-                  "at the weak layer?")
+                  "at the weak layer?",
+         follows="A resolved slab: the run and weac against a static FE")
 def render_closure(data: dict, ctx) -> list[str]:
     cases = data["cases"]
     rows = []
@@ -62,6 +63,11 @@ def render_closure(data: dict, ctx) -> list[str]:
                        bool(changes) and not far,
                        f"{len(changes) - len(far)} of {len(changes)}, from {spct(min(changes))} to {spct(max(changes))}"
                        + (f"; apart: {', '.join(far)}" if far else "") if changes else "no case ran away in both"), ""]
+    failed = [c for c in cases if c["on"].get("status") != "ok"]
+    if failed:
+        out += ["- Failed with the closure: " + "; ".join(
+            f"`{c['test']}` ({c['setup']}): {(c['on'].get('error') or '').split(': ', 1)[-1].split(';')[0]}"
+            for c in failed) + ". The run without the closure is the batch's, which finished.", ""]
     parts = []
     for side, name in (("off", "without"), ("on", "with")):
         ba, rec = _balanced(ran, side)
@@ -83,3 +89,72 @@ def render_closure(data: dict, ctx) -> list[str]:
                 + ".", ""]
     out += [env_note(data)]
     return out
+
+
+STRESS_ON = "field/results/closure/field_closure_stress_on.json"
+STRESS_OFF = "field/results/closure/field_closure_stress_off.json"
+
+
+def _base_summary(fe_rows: list, basal: bool) -> tuple[int, int, float | None]:
+    """Of the slab layers at (``basal``) or clear of the weak layer's stencil: how many agree with the FE within
+    :data:`~.field_slab_fe.AGREE` at the onset, of how many, and the median run over FE."""
+    from .field_slab_fe import AGREE, _pairs  # not at the top: this module's sections follow that one's
+
+    pairs = _pairs(fe_rows, basal=basal)
+    ratios = [r / f for *_, r, f in pairs]
+    return sum(abs(x - 1.0) <= AGREE for x in ratios), len(ratios), (median(ratios) if ratios else None)
+
+
+def _layers(v: list | None) -> str:
+    return ", ".join(fx(x, 2) for x in v) if v else "-"
+
+
+@section("field", "The laminate closure: the slab's stress at the weak layer against the FE", STRESS_ON,
+         lambda d: "python benchmarks/field/closure_stress.py RUNDIR --closure on  # and --closure off; RUNDIR: "
+                   "closure.py's runs",
+         question="Is the slab's stress next to the weak layer, far above a static FE's in the field runs, the "
+                  "grid's bimaterial artefact that the closure removes?",
+         follows="The laminate closure: the same columns without and with it")
+def render_closure_stress(data: dict, ctx) -> list[str]:
+    from .field_slab_fe import AGREE, SMALL, _at_base, _auc
+
+    off = ctx.load(STRESS_OFF) if ctx is not None else None
+    on_rows = [c for c in data["cases"] if c["fe"].get("at_onset")]
+    off_by = {c["id"]: c for c in (off or {}).get("cases", []) if c["fe"].get("at_onset")}
+    rows = []
+    for c in on_rows:
+        o, f = off_by.get(c["id"]), c["fe"]
+        base = sorted(_at_base(f))
+        fe_layers = f["at_onset"]["fe"][-1]["layers"]
+        onset = f"{fx(o['onset_cut'], 3) if o else '-'} / {fx(c['onset_cut'], 3)}"
+        rows.append([f"`{c['test']}`", c["observed"], onset,
+                     ", ".join(str(k + 1) for k in base),
+                     _layers([o["fe"]["run_layers_at_onset"][k] for k in base]) if o else "-",
+                     _layers([f["run_layers_at_onset"][k] for k in base]), _layers([fe_layers[k] for k in base]),
+                     f"{o['predicted'] if o else '-'} / {c['predicted']}"])
+    out = [f"The SF and END columns of the section above, each run from its scenario without and with the closure "
+           "(nothing else changed), the particles' stress stored at every frame, and solved statically at the run's "
+           "onset by the FE of \"A resolved slab\" (the same elements, the same zones left out at the singular "
+           f"corners). Values are the largest principal stress over the layer's tensile strength in the onset frame; "
+           f"the layers at the base are those within {fx(2, 0)} grid cells of the weak layer, numbered from the top. "
+           "Each pair is without / with the closure.", ""]
+    out += table(["record", "observed", "onset (m)", "layers at the base", "run without", "run with", "FE",
+                  "predicted"], rows)
+    out += [""]
+    for basal, what in ((True, "at the base"), (False, "clear of the base")):
+        ok_on, n_on, med_on = _base_summary([c["fe"] for c in on_rows], basal)
+        ok_off, n_off, med_off = _base_summary([c["fe"] for c in off_by.values()], basal) if off_by else (0, 0, None)
+        out.append(check_line(f"the run's slab layers {what} against the FE, with the closure",
+                              f"within {fx(100 * AGREE, 0)} % at the onset, where either reaches {fx(SMALL, 1)} of "
+                              "its strength", n_on > 0 and ok_on == n_on,
+                              f"{ok_on} of {n_on}, the run over the FE median {fx(med_on, 2)}; without the closure "
+                              f"{ok_off} of {n_off}, median {fx(med_off, 2)}"))
+    fe_auc = _auc([c["fe"] for c in on_rows], lambda c: c["at_onset"]["fe"][-1]["peak"])
+    aucs = [(name, _auc([c["fe"] for c in rows_], lambda c: c["run_to_onset"]))
+            for name, rows_ in (("without", list(off_by.values())), ("with", on_rows))]
+    if fe_auc and all(a for _, a in aucs):
+        out += ["", f"- **SF against END at the onset:** the FE's slab peak ranks an SF record above an END record in "
+                f"{fx(100 * fe_auc[0], 0)} % of the {fe_auc[1]} pairs; the run's largest slab stress to the onset "
+                + " and ".join(f"{fx(100 * a[0], 0)} % {name} the closure" for name, a in aucs)
+                + " (50 % is chance)."]
+    return out + ["", env_note(data)]
