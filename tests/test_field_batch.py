@@ -206,3 +206,7 @@ def test_a_protocol_with_the_closure_refuses_a_column_with_a_layer_thinner_than_
     assert r.reason == "thin layer" and r.message == (
         "the laminate closure needs every layer at least a grid cell thick, and slab layer 1 (from the top) is 5.0 "
         "mm, under the 10.00 mm cell the weak layer sets: run this column without --interface-closure")
+    out = tmp_path / "run"                                  # the same through the CLI: refused, nothing run
+    assert main(["field", str(table), "--out", str(out), "--interface-closure", "--quiet"]) == 0
+    with open(out / "refused.csv") as fh:
+        assert "psts.csv#crust,PST 12/40 (End) down 15 cm,End,thin layer,\"the laminate closure needs" in fh.read()
