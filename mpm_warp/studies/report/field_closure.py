@@ -137,7 +137,8 @@ def render_closure_stress(data: dict, ctx) -> list[str]:
            "onset by the FE of \"A resolved slab\" (the same elements, the same zones left out at the singular "
            f"corners). Values are the largest principal stress over the layer's tensile strength in the onset frame; "
            f"the layers at the base are those within {fx(2, 0)} grid cells of the weak layer, numbered from the top. "
-           "Each pair is without / with the closure.", ""]
+           "Each pair is without / with the closure; the runs without it: "
+           + (ctx.link(STRESS_OFF) if ctx is not None else STRESS_OFF) + ".", ""]
     out += table(["record", "observed", "onset (m)", "layers at the base", "run without", "run with", "FE",
                   "predicted"], rows)
     out += [""]
