@@ -209,6 +209,7 @@ class Simulation:
         self.stepper.set_frame_end(t_end)
         t, dt, steps0 = self.stepper.clock()
         taken = 0
+        dt_floor = MIN_DT_SHARE * self._first_dt()     # below it the state has diverged (mpm_warp.health)
         while t < t_end * (1 - 1e-12) - 1e-15:
             if dt <= 0:
                 dt = self._first_dt()
@@ -216,19 +217,18 @@ class Simulation:
             if self.stepper.use_graph:
                 n = self.stepper.graph_batch  # one captured graph; the steps past t_end are no-ops (dt = 0)
             self.stepper.steps(n)
-            t_before, steps_before = t, steps0 + taken
+            t_before = t
             t, dt_new, steps = self.stepper.clock()
             taken = steps - steps0
             self._since_health += n
             if self._since_health >= he:
                 self.health()
                 self._since_health = 0
-            if t < t_end * (1 - 1e-12) - 1e-15 and (steps == steps_before or t == t_before
-                                                    or not dt_new >= MIN_DT_SHARE * self._first_dt()):
+            if t < t_end * (1 - 1e-12) - 1e-15 and (t == t_before or not dt_new >= dt_floor):
                 raise SimulationBlowUp(steps, -1, "dt", (
                     f"the time step fell to {dt_new:.3g} s at t = {t:.6g} s, below {MIN_DT_SHARE:g} of the elastic "
-                    f"step ({self._first_dt():.3g} s): the largest nodal speed is not finite or beyond any physical "
-                    "one (the state diverged)"))
+                    f"step ({dt_floor / MIN_DT_SHARE:.3g} s): the largest nodal speed is not finite or beyond any "
+                    "physical one (the state diverged)"))
             dt = dt_new if dt_new > 0 else dt
             if self._stop_now:
                 break

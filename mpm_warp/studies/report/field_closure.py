@@ -142,25 +142,26 @@ def render_closure_stress(data: dict, ctx) -> list[str]:
     out += table(["record", "observed", "onset (m)", "layers at the base", "run without", "run with", "FE",
                   "predicted"], rows)
     out += [""]
-    ok_on, n_on, med_on = _base_summary([c["fe"] for c in on_rows], True)
-    ok_off, n_off, med_off = _base_summary([c["fe"] for c in off_by.values()], True) if off_by else (0, 0, None)
+    on_fe, off_fe = [c["fe"] for c in on_rows], [c["fe"] for c in off_by.values()]
+    summary = {basal: (_base_summary(on_fe, basal), _base_summary(off_fe, basal) if off_fe else (0, 0, None))
+               for basal in (True, False)}
     for basal, what in ((True, "at the base"), (False, "clear of the base")):
-        a_on, k_on, m_on = _base_summary([c["fe"] for c in on_rows], basal)
-        a_off, k_off, m_off = _base_summary([c["fe"] for c in off_by.values()], basal) if off_by else (0, 0, None)
+        (a_on, k_on, m_on), (a_off, k_off, m_off) = summary[basal]
         out.append(check_line(f"the run's slab layers {what} against the FE, with the closure",
                               f"within {fx(100 * AGREE, 0)} % at the onset, where either reaches {fx(SMALL, 1)} of "
                               "its strength", k_on > 0 and a_on == k_on,
                               f"{a_on} of {k_on}, the run over the FE median {fx(m_on, 2)}; without the closure "
                               f"{a_off} of {k_off}, median {fx(m_off, 2)}"))
+    med_on, med_off = summary[True][0][2], summary[True][1][2]
     if med_on is not None and med_off is not None and med_on > 1.0 + AGREE:
         out += ["", f"- The closure takes the base layers' stress from {fx(med_off, 2)} to {fx(med_on, 2)} times "
                 "the FE's (medians): most of the excess stays, so it is not the settled column's bimaterial artefact, "
                 "which the closure removes (\"Stress at the weak layer's interfaces\"). What is left lies among what "
                 "the static FE leaves out at the onset: the saw's and the settling's dynamics, and a weak layer that "
                 "softens ahead of the blade where the FE's stays elastic up to the cut."]
-    fe_auc = _auc([c["fe"] for c in on_rows], lambda c: c["at_onset"]["fe"][-1]["peak"])
-    aucs = [(name, _auc([c["fe"] for c in rows_], lambda c: c["run_to_onset"]))
-            for name, rows_ in (("without", list(off_by.values())), ("with", on_rows))]
+    fe_auc = _auc(on_fe, lambda c: c["at_onset"]["fe"][-1]["peak"])
+    aucs = [(name, _auc(fe_rows, lambda c: c["run_to_onset"]))
+            for name, fe_rows in (("without", off_fe), ("with", on_fe))]
     if fe_auc and all(a for _, a in aucs):
         out += ["", f"- **SF against END at the onset:** the FE's slab peak ranks an SF record above an END record in "
                 f"{fx(100 * fe_auc[0], 0)} % of the {fe_auc[1]} pairs; the run's largest slab stress to the onset "
