@@ -1,0 +1,113 @@
+"""Would a weaker slab tell SF from END? The field columns run again with their slab's tensile strength scaled.
+
+The model calls 35 of the development set's 45 SF records END: their slab never cracked through (docs/results.md,
+"Field outcomes against the observers"). The static FE's slab stress ranks an SF record above an END record in 85 %
+of the pairs (docs/results.md, "A resolved slab"), so the SF slabs are the more loaded ones, but at a fraction of
+their strength (Sigrist 2006 from the density, docs/model.md §9). This sensitivity study asks whether the strength
+law is the lever: if a slab weaker by a factor ``--scale`` broke mostly in the SF records and seldom in the END
+ones, an independently measured field-scale strength would be worth taking; if it broke in both alike, the
+strength law cannot separate them. The factor is a what-if, never a calibration: no default changes.
+
+It draws the cases as ``closure.py`` does (``--per-class`` of each observed class at random, ``--seed``, among the
+committed batches' cases whose run took at most ``--max-wall`` s), sets each up again from its pit (its id's
+digest must match the batch's), sets every slab layer's tensile strength to ``--scale`` times its density law's,
+nothing else changed (the fracture energy stays the density law's), and runs it by the field protocol into
+``--runs`` (a Dask batch: resumable). Per case: the class, the runaway cut and where the slab broke, at the
+density law's strength (the batch's run) and scaled. Writes ``benchmarks/field/results/field_strength.json``.
+
+Usage: ``python benchmarks/field/strength.py DIR --runs RUNDIR [--scale 0.5] [--per-class 8] [--seed 0]
+[--max-wall 120] [--workers N]``; ``--quick``: one case of at most 20 s, to a temporary folder. Minutes a case.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import sys
+import tempfile
+import time
+import warnings
+
+from closure import BATCHES, KEYS, draw, matched_cases
+
+from mpm_warp.field.batch import run_cases
+from mpm_warp.field.protocol import FieldProtocol
+from mpm_warp.scenes.density_laws import sigrist_tensile_strength
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "results")
+
+
+def weaker(case, scale: float):
+    """``case`` with every slab layer's tensile strength ``scale`` times its density law's (Pa), and nothing else
+    changed; a layer given its own strength keeps it scaled the same way."""
+    def scaled(layer):
+        base = layer.tensile_strength or sigrist_tensile_strength(layer.density)
+        return dataclasses.replace(layer, tensile_strength=scale * base)
+
+    p = case.params
+    if p.slab_layers:
+        p = dataclasses.replace(p, slab_layers=tuple(scaled(ly) for ly in p.slab_layers))
+    else:
+        p = dataclasses.replace(p, slab=scaled(p.slab))
+    return dataclasses.replace(case, params=p.validate("scene"))
+
+
+def main(argv=None) -> int:
+    p = parser(__doc__, "one case of at most 20 s")
+    p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
+    p.add_argument("--runs", help="folder of the runs with the scaled strength (kept: a rerun resumes)")
+    p.add_argument("--batches", nargs="+", default=list(BATCHES), help="field_batch.py JSONs (default: both committed)")
+    p.add_argument("--scale", type=float, default=0.5, help="the slab's tensile strength over its law's (default 0.5)")
+    p.add_argument("--per-class", type=int, default=8, help="cases to draw per observed class (default 8)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
+    p.add_argument("--max-wall", type=float, default=120.0,
+                   help="draw among the cases whose batch run took at most this long (s, default 120)")
+    p.add_argument("--workers", type=int, default=None, help="Dask workers (default one per core)")
+    p.add_argument("--threads", type=int, default=FieldProtocol.threads, help="CPU threads of each case (default 1)")
+    args = p.parse_args(argv)
+    if not 0.0 < args.scale <= 1.0:
+        print(f"error: --scale = {args.scale:g} is invalid: expected a factor in (0, 1]", file=sys.stderr)
+        return 2
+    warnings.filterwarnings("ignore")
+    cap = 20.0 if args.quick else args.max_wall
+    chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
+    chosen = chosen[:1] if args.quick else chosen
+    proto = FieldProtocol(threads=args.threads).validate()
+    t0 = time.perf_counter()
+    cases, missing = matched_cases(args.data, [c["id"] for c in chosen], proto)
+    if missing:
+        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
+              file=sys.stderr)
+        return 2
+    cases = [weaker(c, args.scale) for c in cases]
+    setup_s = time.perf_counter() - t0
+    dest = out_dir(args, RESULTS, "field_strength")
+    env = environment("cpu")
+    with tempfile.TemporaryDirectory(prefix="mpm_warp_strength_") as tmp:
+        runs = args.runs or tmp
+        batch = run_cases(cases, [], runs, workers=args.workers, protocol=proto)
+    rows = []
+    for b, rec in zip(chosen, batch.records, strict=True):
+        rows.append({"id": b["id"], "scaled_id": rec["id"], "test": b["test"], "observed": b["observed"],
+                     "w_f": b["w_f"], "w_f_source": b["w_f_source"], "setup": b["setup"],
+                     "law": {k: b.get(k) for k in KEYS}, "scaled": {k: rec.get(k) for k in KEYS + ("error",)}})
+        print(f"{b['test']} ({b['observed']}): {b['predicted']} -> {rec.get('predicted')}, slab broke at "
+              f"{b.get('slab_fracture_at')} -> {rec.get('slab_fracture_at')}", flush=True)
+    data = {"name": "field_strength", "scale": args.scale,
+            "batches": [os.path.relpath(b, HERE) for b in args.batches],
+            "per_class": args.per_class, "seed": args.seed, "max_wall_s": cap,
+            "chosen": f"{len(chosen)} drawn ({args.per_class} per observed class, seed {args.seed}) from the {pool} "
+                      f"finished cases of the batches whose run took at most {cap:g} s",
+            "runs": os.path.basename(os.path.normpath(args.runs)) if args.runs else None,
+            "protocol": proto.run_key(), "threads": args.threads, "workers": args.workers, "setup_s": setup_s,
+            "environment": env, "cases": rows}
+    path = write_json("field_strength", data, dest)
+    print(f"{path}: {len(rows)} cases")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
