@@ -39,6 +39,7 @@ from . import (  # noqa: F401
     field_rigid_base,
     field_slab,
     field_slab_fe,
+    field_strength,
     main_job,
     perf,
     perf_cuda,
