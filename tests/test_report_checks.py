@@ -29,7 +29,8 @@ COMPARING = {"Error against run time: the reference problems": 2,
              "The grid: the same columns at 6 cells across the weak layer": 2, "CUDA: the device suite": 3,
              "Throughput beside Taichi, 2D": 1,
              "The laminate closure: the same columns without and with it": 2,
-             "The laminate closure: the slab's stress at the weak layer against the FE": 2}
+             "The laminate closure: the slab's stress at the weak layer against the FE": 2,
+             "The slab's strength: the same columns with a weaker slab": 1}
 LINE = re.compile(r"^- \*\*Check, [^*]+:\*\* .+: \*\*(pass|FAIL|open)\*\*( \(.+\))?\.$")
 
 
@@ -158,3 +159,14 @@ def test_a_section_that_follows_another_lands_after_it_whichever_is_registered_f
     (tmp_path / "benchmarks").mkdir()
     with pytest.raises(InvalidArgument, match="follows"):
         core.document(core.Context(str(tmp_path)))
+
+
+def test_the_strength_study_asks_chance_with_fishers_exact_tail():
+    from mpm_warp.studies.report.field_strength import fisher_greater
+
+    # Fisher's tea tasting: all 4 of 4 against 0 of 4 is 1 arrangement in C(8, 4) = 70
+    assert fisher_greater(4, 4, 0, 4) == pytest.approx(1.0 / 70.0, rel=1e-12)
+    # 2 of 8 against 1 of 8: P(2 or 3 of the 3 hits among the first 8) = (C(8,2) C(8,1) + C(8,3)) / C(16,3)
+    assert fisher_greater(2, 8, 1, 8) == pytest.approx((28 * 8 + 56) / 560, rel=1e-12)
+    assert fisher_greater(0, 8, 0, 8) == 1.0
+    assert fisher_greater(0, 8, 3, 8) == 1.0    # no share larger than the other's: the whole tail

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from statistics import median
 
 from .core import section
@@ -17,8 +18,10 @@ def _to_sf(cases: list, cls: str, side: str) -> tuple[int, int]:
     return sum(c[side]["predicted"] == "SF" for c in of), len(of)
 
 
-#: the same draw at other factors (``--out``), summarised beside the section's own
-MORE = ("field/results/strength_0.25/field_strength.json",)
+#: the section's own run: the largest draw, at a quarter of the law's strength
+MAIN = "field/results/strength/0.25_16/field_strength.json"
+#: smaller draws (8 a class, the same seed: a draw of its own) at both factors, summarised beside it
+MORE = ("field/results/strength/0.5_8/field_strength.json", "field/results/strength/0.25_8/field_strength.json")
 
 
 def fisher_greater(a: int, n: int, b: int, m: int) -> float:
@@ -42,7 +45,8 @@ def _summary(data: dict) -> list:
     ba, _ = _balanced(ran, "scaled")
     (a, n), (b, m) = got["SF"], got["END"]
     p = fisher_greater(a, n, b, m) if n and m else None
-    return [fx(data["scale"], 2), *cells, fx(ba, 2), fx(p, 2)], p, a / n if n else None, b / m if m else None
+    row = [fx(data["scale"], 2), str(data["per_class"]), *cells, fx(ba, 2), fx(p, 2)]
+    return row, p, a / n if n else None, b / m if m else None
 
 
 def _balanced(cases: list, side: str) -> tuple[float | None, dict]:
@@ -54,11 +58,10 @@ def _balanced(cases: list, side: str) -> tuple[float | None, dict]:
     return (sum(recall.values()) / len(recall) if recall else None), recall
 
 
-@section("field", "The slab's strength: the same columns with a weaker slab",
-         "field/results/field_strength.json",
+@section("field", "The slab's strength: the same columns with a weaker slab", MAIN,
          lambda d: f"python benchmarks/field/strength.py DIR --runs RUNDIR --scale {d['scale']:g} "
                    f"--per-class {d['per_class']} --seed {d['seed']} --max-wall {d['max_wall_s']:g} "
-                   f"--workers {d['workers']} --threads {d['threads']}",
+                   f"--workers {d['workers']} --threads {d['threads']} --out benchmarks/{os.path.dirname(MAIN)}",
          question="Is the slab's tensile strength the lever that would tell SF from END? The same columns, every slab "
                   "layer's strength scaled by a what-if factor (not a calibration: no default changes).",
          follows="The laminate closure: the slab's stress at the weak layer against the FE")
@@ -87,14 +90,14 @@ def render_strength(data: dict, ctx) -> list[str]:
     out += ["", check_line(f"a slab {fx(s, 2)} times as strong breaks where the observer saw SF rather than END",
                            "a larger share of the SF records than of the END records predicted SF, beyond chance "
                            "(one-sided Fisher exact test, p <= 0.05)", passed,
-                           f"SF records {row[2]}, END records {row[1]}, ARR records {row[3]}, the law's strength in "
-                           f"brackets; p = {row[5]}" + ("; too few cases to tell" if passed is None else "")), ""]
+                           f"SF records {row[3]}, END records {row[2]}, ARR records {row[4]}, the law's strength in "
+                           f"brackets; p = {row[6]}" + ("; too few cases to tell" if passed is None else "")), ""]
     summary = [row] + [_summary(d)[0] for d in others]
-    out += table(["strength over the law's", "END records predicted SF", "SF records predicted SF",
+    out += table(["strength over the law's", "cases a class", "END records predicted SF", "SF records predicted SF",
                   "ARR records predicted SF", "balanced accuracy", "p, SF against END"],
-                 sorted(summary, key=lambda r: -float(r[0])))
+                 sorted(summary, key=lambda r: (-float(r[0]), int(r[1]))))
     out += ["", "Each count is of the records that ran, with the count at the law's strength in brackets."
-            + (" Other factors: the same draw and command with `--scale` and `--out` ("
+            + (" The smaller draws: the same command with `--scale`, `--per-class 8` and `--out` ("
                + ", ".join(ctx.link(f) for f in more) + ")." if more else ""), ""]
     parts = []
     for side, name in (("law", "at the law's strength"), ("scaled", f"at {fx(s, 2)} of it")):
