@@ -71,17 +71,24 @@ def draw(batches: list[str], per_class: int, seed: int, max_wall: float) -> tupl
     return chosen, len(ordered)
 
 
-def main(argv=None) -> int:
-    p = parser(__doc__, "one case of at most 20 s")
+def add_draw_arguments(p, runs: str, per_class: int) -> None:
+    """The arguments of a study that draws cases per observed class from the committed batches and runs them:
+    the data, the runs folder (``runs`` says which runs), the draw and the Dask batch."""
     p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
-    p.add_argument("--runs", help="folder of the runs with the closure (kept: a rerun resumes); default temporary")
+    p.add_argument("--runs", help=f"folder of the runs {runs} (kept: a rerun resumes); default temporary")
     p.add_argument("--batches", nargs="+", default=list(BATCHES), help="field_batch.py JSONs (default: both committed)")
-    p.add_argument("--per-class", type=int, default=6, help="cases to draw per observed class (default 6)")
+    p.add_argument("--per-class", type=int, default=per_class,
+                   help=f"cases to draw per observed class (default {per_class})")
     p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
     p.add_argument("--max-wall", type=float, default=120.0,
                    help="draw among the cases whose batch run took at most this long (s, default 120)")
     p.add_argument("--workers", type=int, default=None, help="Dask workers (default one per core)")
     p.add_argument("--threads", type=int, default=FieldProtocol.threads, help="CPU threads of each case (default 1)")
+
+
+def main(argv=None) -> int:
+    p = parser(__doc__, "one case of at most 20 s")
+    add_draw_arguments(p, "with the closure", per_class=6)
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
     cap = 20.0 if args.quick else args.max_wall

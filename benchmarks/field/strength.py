@@ -13,7 +13,8 @@ committed batches' cases whose run took at most ``--max-wall`` s), sets each up 
 digest must match the batch's), sets every slab layer's tensile strength to ``--scale`` times its density law's,
 nothing else changed (the fracture energy stays the density law's), and runs it by the field protocol into
 ``--runs`` (a Dask batch: resumable). Per case: the class, the runaway cut and where the slab broke, at the
-density law's strength (the batch's run) and scaled. Writes ``benchmarks/field/results/field_strength.json``.
+density law's strength (the batch's run) and scaled. Writes ``field_strength.json`` under
+``benchmarks/field/results/`` or ``--out``.
 
 Usage: ``python benchmarks/field/strength.py DIR --runs RUNDIR [--scale 0.5] [--per-class 8] [--seed 0]
 [--max-wall 120] [--workers N]``; ``--quick``: one case of at most 20 s, to a temporary folder. Minutes a case.
@@ -28,7 +29,7 @@ import tempfile
 import time
 import warnings
 
-from closure import BATCHES, KEYS, draw, matched_cases
+from closure import KEYS, add_draw_arguments, draw, matched_cases
 
 from mpm_warp.field.batch import run_cases
 from mpm_warp.field.protocol import FieldProtocol
@@ -57,16 +58,8 @@ def weaker(case, scale: float):
 
 def main(argv=None) -> int:
     p = parser(__doc__, "one case of at most 20 s")
-    p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
-    p.add_argument("--runs", help="folder of the runs with the scaled strength (kept: a rerun resumes)")
-    p.add_argument("--batches", nargs="+", default=list(BATCHES), help="field_batch.py JSONs (default: both committed)")
+    add_draw_arguments(p, "with the scaled strength", per_class=8)
     p.add_argument("--scale", type=float, default=0.5, help="the slab's tensile strength over its law's (default 0.5)")
-    p.add_argument("--per-class", type=int, default=8, help="cases to draw per observed class (default 8)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
-    p.add_argument("--max-wall", type=float, default=120.0,
-                   help="draw among the cases whose batch run took at most this long (s, default 120)")
-    p.add_argument("--workers", type=int, default=None, help="Dask workers (default one per core)")
-    p.add_argument("--threads", type=int, default=FieldProtocol.threads, help="CPU threads of each case (default 1)")
     args = p.parse_args(argv)
     if not 0.0 < args.scale <= 1.0:
         print(f"error: --scale = {args.scale:g} is invalid: expected a factor in (0, 1]", file=sys.stderr)

@@ -7,7 +7,7 @@ import os
 from statistics import median
 
 from .core import section
-from .field_closure import CLASSES
+from .field_closure import CLASSES, _balanced
 from .field_rigid_base import _cut
 from .fmt import check_line, count, env_note, fx, spct, table
 
@@ -47,15 +47,6 @@ def _summary(data: dict) -> list:
     p = fisher_greater(a, n, b, m) if n and m else None
     row = [fx(data["scale"], 2), str(data["per_class"]), *cells, fx(ba, 2), fx(p, 2)]
     return row, p, a / n if n else None, b / m if m else None
-
-
-def _balanced(cases: list, side: str) -> tuple[float | None, dict]:
-    recall = {}
-    for cls in CLASSES:
-        of = [c for c in cases if c["observed"] == cls]
-        if of:
-            recall[cls] = sum(c[side]["predicted"] == cls for c in of) / len(of)
-    return (sum(recall.values()) / len(recall) if recall else None), recall
 
 
 @section("field", "The slab's strength: the same columns with a weaker slab", MAIN,
