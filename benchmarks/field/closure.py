@@ -86,42 +86,56 @@ def add_draw_arguments(p, runs: str, per_class: int) -> None:
     p.add_argument("--threads", type=int, default=FieldProtocol.threads, help="CPU threads of each case (default 1)")
 
 
+def draw_and_run(args, name: str, env: dict, proto: FieldProtocol, run_proto: FieldProtocol, adjust=None):
+    """The drawn cases (``add_draw_arguments``) set up again from their pits under ``proto`` (each must match its
+    batch's digest), changed by ``adjust(case)`` when given, and run under ``run_proto`` into ``args.runs`` (or a
+    temporary folder). Returns ``(chosen, records, meta)``: the batch rows drawn, the new runs' records in the same
+    order, and the fields every such study's JSON carries (``env``, the script's environment, recorded before the
+    runs); None when a case does not match (said on stderr)."""
+    cap = 20.0 if args.quick else args.max_wall
+    chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
+    chosen = chosen[:1] if args.quick else chosen
+    t0 = time.perf_counter()
+    cases, missing = matched_cases(args.data, [c["id"] for c in chosen], proto)
+    if missing:
+        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
+              file=sys.stderr)
+        return None
+    cases = [adjust(c) for c in cases] if adjust is not None else cases
+    setup_s = time.perf_counter() - t0
+    dest = out_dir(args, RESULTS, name)
+    with tempfile.TemporaryDirectory(prefix=f"mpm_warp_{name}_") as tmp:
+        batch = run_cases(cases, [], args.runs or tmp, workers=args.workers, protocol=run_proto)
+    meta = {"batches": [os.path.relpath(b, HERE) for b in args.batches],
+            "per_class": args.per_class, "seed": args.seed, "max_wall_s": cap,
+            "chosen": f"{len(chosen)} drawn ({args.per_class} per observed class, seed {args.seed}) from the {pool} "
+                      f"finished cases of the batches whose run took at most {cap:g} s",
+            "runs": os.path.basename(os.path.normpath(args.runs)) if args.runs else None,
+            "protocol": run_proto.run_key(), "threads": args.threads, "workers": args.workers, "setup_s": setup_s,
+            "environment": env, "dest": dest}
+    return chosen, batch.records, meta
+
+
 def main(argv=None) -> int:
     p = parser(__doc__, "one case of at most 20 s")
     add_draw_arguments(p, "with the closure", per_class=6)
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
-    cap = 20.0 if args.quick else args.max_wall
-    chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
-    chosen = chosen[:1] if args.quick else chosen
     off = FieldProtocol(threads=args.threads).validate()
     on = FieldProtocol(threads=args.threads, interface_closure=True).validate()
-    t0 = time.perf_counter()
-    cases, missing = matched_cases(args.data, [c["id"] for c in chosen], off)
-    if missing:
-        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
-              file=sys.stderr)
+    drawn = draw_and_run(args, "field_closure", environment("cpu"), off, on)
+    if drawn is None:
         return 2
-    setup_s = time.perf_counter() - t0
-    dest = out_dir(args, RESULTS, "field_closure")
-    env = environment("cpu")
-    with tempfile.TemporaryDirectory(prefix="mpm_warp_closure_") as tmp:
-        runs = args.runs or tmp
-        batch = run_cases(cases, [], runs, workers=args.workers, protocol=on)
+    chosen, records, meta = drawn
     rows = []
-    for b, rec in zip(chosen, batch.records, strict=True):
+    for b, rec in zip(chosen, records, strict=True):
         rows.append({"id": b["id"], "closure_id": rec["id"], "test": b["test"], "observed": b["observed"],
                      "w_f": b["w_f"], "w_f_source": b["w_f_source"], "setup": b["setup"],
                      "off": {k: b.get(k) for k in KEYS}, "on": {k: rec.get(k) for k in KEYS + ("error",)}})
         print(f"{b['test']} ({b['observed']}): {b['predicted']} -> {rec.get('predicted')}, runaway "
               f"{b['runaway_cut']} -> {rec.get('runaway_cut')}", flush=True)
-    data = {"name": "field_closure", "batches": [os.path.relpath(b, HERE) for b in args.batches],
-            "per_class": args.per_class, "seed": args.seed, "max_wall_s": cap,
-            "chosen": f"{len(chosen)} drawn ({args.per_class} per observed class, seed {args.seed}) from the {pool} "
-                      f"finished cases of the batches whose run took at most {cap:g} s",
-            "runs": os.path.basename(os.path.normpath(args.runs)) if args.runs else None,
-            "protocol": on.run_key(), "threads": args.threads, "workers": args.workers, "setup_s": setup_s,
-            "environment": env, "cases": rows}
+    dest = meta.pop("dest")
+    data = {"name": "field_closure", **meta, "cases": rows}
     path = write_json("field_closure", data, dest)
     print(f"{path}: {len(rows)} cases")
     return 0

@@ -25,17 +25,14 @@ from __future__ import annotations
 import dataclasses
 import os
 import sys
-import tempfile
-import time
 import warnings
 
-from closure import KEYS, add_draw_arguments, draw, matched_cases
+from closure import KEYS, add_draw_arguments, draw_and_run
 
-from mpm_warp.field.batch import run_cases
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.scenes.density_laws import sigrist_tensile_strength
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.protocol import parser
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
@@ -65,38 +62,21 @@ def main(argv=None) -> int:
         print(f"error: --scale = {args.scale:g} is invalid: expected a factor in (0, 1]", file=sys.stderr)
         return 2
     warnings.filterwarnings("ignore")
-    cap = 20.0 if args.quick else args.max_wall
-    chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
-    chosen = chosen[:1] if args.quick else chosen
     proto = FieldProtocol(threads=args.threads).validate()
-    t0 = time.perf_counter()
-    cases, missing = matched_cases(args.data, [c["id"] for c in chosen], proto)
-    if missing:
-        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
-              file=sys.stderr)
+    drawn = draw_and_run(args, "field_strength", environment("cpu"), proto, proto,
+                         adjust=lambda c: weaker(c, args.scale))
+    if drawn is None:
         return 2
-    cases = [weaker(c, args.scale) for c in cases]
-    setup_s = time.perf_counter() - t0
-    dest = out_dir(args, RESULTS, "field_strength")
-    env = environment("cpu")
-    with tempfile.TemporaryDirectory(prefix="mpm_warp_strength_") as tmp:
-        runs = args.runs or tmp
-        batch = run_cases(cases, [], runs, workers=args.workers, protocol=proto)
+    chosen, records, meta = drawn
     rows = []
-    for b, rec in zip(chosen, batch.records, strict=True):
+    for b, rec in zip(chosen, records, strict=True):
         rows.append({"id": b["id"], "scaled_id": rec["id"], "test": b["test"], "observed": b["observed"],
                      "w_f": b["w_f"], "w_f_source": b["w_f_source"], "setup": b["setup"],
                      "law": {k: b.get(k) for k in KEYS}, "scaled": {k: rec.get(k) for k in KEYS + ("error",)}})
         print(f"{b['test']} ({b['observed']}): {b['predicted']} -> {rec.get('predicted')}, slab broke at "
               f"{b.get('slab_fracture_at')} -> {rec.get('slab_fracture_at')}", flush=True)
-    data = {"name": "field_strength", "scale": args.scale,
-            "batches": [os.path.relpath(b, HERE) for b in args.batches],
-            "per_class": args.per_class, "seed": args.seed, "max_wall_s": cap,
-            "chosen": f"{len(chosen)} drawn ({args.per_class} per observed class, seed {args.seed}) from the {pool} "
-                      f"finished cases of the batches whose run took at most {cap:g} s",
-            "runs": os.path.basename(os.path.normpath(args.runs)) if args.runs else None,
-            "protocol": proto.run_key(), "threads": args.threads, "workers": args.workers, "setup_s": setup_s,
-            "environment": env, "cases": rows}
+    dest = meta.pop("dest")
+    data = {"name": "field_strength", "scale": args.scale, **meta, "cases": rows}
     path = write_json("field_strength", data, dest)
     print(f"{path}: {len(rows)} cases")
     return 0
