@@ -91,7 +91,8 @@ def draw_and_run(args, name: str, env: dict, proto: FieldProtocol, run_proto: Fi
     batch's digest), changed by ``adjust(case)`` when given, and run under ``run_proto`` into ``args.runs`` (or a
     temporary folder). Returns ``(chosen, records, meta)``: the batch rows drawn, the new runs' records in the same
     order, and the fields every such study's JSON carries (``env``, the script's environment, recorded before the
-    runs); None when a case does not match (said on stderr)."""
+    runs) with ``dest`` (the JSON's folder) and ``cases`` (the cases run), which the caller pops; None when a case
+    does not match (said on stderr)."""
     cap = 20.0 if args.quick else args.max_wall
     chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
     chosen = chosen[:1] if args.quick else chosen
@@ -112,7 +113,7 @@ def draw_and_run(args, name: str, env: dict, proto: FieldProtocol, run_proto: Fi
                       f"finished cases of the batches whose run took at most {cap:g} s",
             "runs": os.path.basename(os.path.normpath(args.runs)) if args.runs else None,
             "protocol": run_proto.run_key(), "threads": args.threads, "workers": args.workers, "setup_s": setup_s,
-            "environment": env, "dest": dest}
+            "environment": env, "dest": dest, "cases": cases}
     return chosen, batch.records, meta
 
 
@@ -135,6 +136,7 @@ def main(argv=None) -> int:
         print(f"{b['test']} ({b['observed']}): {b['predicted']} -> {rec.get('predicted')}, runaway "
               f"{b['runaway_cut']} -> {rec.get('runaway_cut')}", flush=True)
     dest = meta.pop("dest")
+    meta.pop("cases")
     data = {"name": "field_closure", **meta, "cases": rows}
     path = write_json("field_closure", data, dest)
     print(f"{path}: {len(rows)} cases")

@@ -16,8 +16,9 @@ nothing else changed (the fracture energy stays the density law's), and runs it 
 density law's strength (the batch's run) and scaled. Writes ``field_strength.json`` under
 ``benchmarks/field/results/`` or ``--out``.
 
-Usage: ``python benchmarks/field/strength.py DIR --runs RUNDIR [--scale 0.5] [--per-class 8] [--seed 0]
-[--max-wall 120] [--workers N]``; ``--quick``: one case of at most 20 s, to a temporary folder. Minutes a case.
+Usage: ``python benchmarks/field/strength.py DIR --runs RUNDIR [--scale 0.5] [--faceted 1] [--per-class 8]
+[--seed 0] [--max-wall 120] [--workers N]``; ``--quick``: one case of at most 20 s, to a temporary folder.
+Minutes a case.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ import warnings
 from closure import KEYS, add_draw_arguments, draw_and_run
 
 from mpm_warp.field.protocol import FieldProtocol
+from mpm_warp.field.static_rule import weac_static_class
 from mpm_warp.scenes.density_laws import sigrist_tensile_strength
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import parser
@@ -38,12 +40,23 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
 
 
-def weaker(case, scale: float):
-    """``case`` with every slab layer's tensile strength ``scale`` times its density law's (Pa), and nothing else
-    changed; a layer given its own strength keeps it scaled the same way."""
+#: primary grain forms of faceted snow (IACS classes FC and DH, every subclass)
+FACETED = ("FC", "DH")
+
+
+def faceted(layer) -> bool:
+    """Whether a field column's slab layer is of faceted snow: its name starts with its grains, primary first
+    (``"FCxr/RG 4F, 180 kg/m3 (estimated)"``, docs/profiles.md)."""
+    return (layer.name or "").startswith(FACETED)
+
+
+def weaker(case, scale: float, facets: float = 1.0):
+    """``case`` with every slab layer's tensile strength ``scale`` times its density law's (Pa), ``facets`` times
+    more for a layer of faceted snow, and nothing else changed; a layer given its own strength keeps it scaled the
+    same way."""
     def scaled(layer):
         base = layer.tensile_strength or sigrist_tensile_strength(layer.density)
-        return dataclasses.replace(layer, tensile_strength=scale * base)
+        return dataclasses.replace(layer, tensile_strength=scale * base * (facets if faceted(layer) else 1.0))
 
     p = case.params
     if p.slab_layers:
@@ -57,26 +70,34 @@ def main(argv=None) -> int:
     p = parser(__doc__, "one case of at most 20 s")
     add_draw_arguments(p, "with the scaled strength", per_class=8)
     p.add_argument("--scale", type=float, default=0.5, help="the slab's tensile strength over its law's (default 0.5)")
+    p.add_argument("--faceted", type=float, default=1.0,
+                   help="a faceted layer's (FC, DH) strength over the scaled law's (default 1; in situ about 0.5)")
     args = p.parse_args(argv)
-    if not 0.0 < args.scale <= 1.0:
-        print(f"error: --scale = {args.scale:g} is invalid: expected a factor in (0, 1]", file=sys.stderr)
-        return 2
+    for name, v in (("--scale", args.scale), ("--faceted", args.faceted)):
+        if not 0.0 < v <= 1.0:
+            print(f"error: {name} = {v:g} is invalid: expected a factor in (0, 1]", file=sys.stderr)
+            return 2
     warnings.filterwarnings("ignore")
     proto = FieldProtocol(threads=args.threads).validate()
     drawn = draw_and_run(args, "field_strength", environment("cpu"), proto, proto,
-                         adjust=lambda c: weaker(c, args.scale))
+                         adjust=lambda c: weaker(c, args.scale, args.faceted))
     if drawn is None:
         return 2
     chosen, records, meta = drawn
     rows = []
-    for b, rec in zip(chosen, records, strict=True):
+    for b, rec, case in zip(chosen, records, meta.pop("cases"), strict=True):
+        layers = case.params.slab_stack()
+        share = sum(ly.thickness for ly in layers if faceted(ly)) / sum(ly.thickness for ly in layers)
         rows.append({"id": b["id"], "scaled_id": rec["id"], "test": b["test"], "observed": b["observed"],
-                     "w_f": b["w_f"], "w_f_source": b["w_f_source"], "setup": b["setup"],
-                     "law": {k: b.get(k) for k in KEYS}, "scaled": {k: rec.get(k) for k in KEYS + ("error",)}})
+                     "w_f": b["w_f"], "w_f_source": b["w_f_source"], "setup": b["setup"], "faceted_share": share,
+                     "law": {k: b.get(k) for k in KEYS + ("static_class",)},
+                     "scaled": {k: rec.get(k) for k in KEYS + ("error",)} | {"static_class": weac_static_class(
+                         case.params)}})
         print(f"{b['test']} ({b['observed']}): {b['predicted']} -> {rec.get('predicted')}, slab broke at "
               f"{b.get('slab_fracture_at')} -> {rec.get('slab_fracture_at')}", flush=True)
     dest = meta.pop("dest")
-    data = {"name": "field_strength", "scale": args.scale, **meta, "cases": rows}
+    data = {"name": "field_strength", "scale": args.scale, "faceted": args.faceted, "faceted_grains": list(FACETED),
+            **meta, "cases": rows}
     path = write_json("field_strength", data, dest)
     print(f"{path}: {len(rows)} cases")
     return 0
