@@ -30,7 +30,8 @@ COMPARING = {"Error against run time: the reference problems": 2,
              "Throughput beside Taichi, 2D": 1,
              "The laminate closure: the same columns without and with it": 2,
              "The laminate closure: the slab's stress at the weak layer against the FE": 2,
-             "The slab's strength: the same columns with a weaker slab": 1}
+             "The slab's strength: the same columns with a weaker slab": 2,
+             "The slab's strength by grain form: weac's static rule on every scored column": 1}
 LINE = re.compile(r"^- \*\*Check, [^*]+:\*\* .+: \*\*(pass|FAIL|open)\*\*( \(.+\))?\.$")
 
 
@@ -170,3 +171,32 @@ def test_the_strength_study_asks_chance_with_fishers_exact_tail():
     assert fisher_greater(2, 8, 1, 8) == pytest.approx((28 * 8 + 56) / 560, rel=1e-12)
     assert fisher_greater(0, 8, 0, 8) == 1.0
     assert fisher_greater(0, 8, 3, 8) == 1.0    # no share larger than the other's: the whole tail
+
+
+def _static_case(observed, law, grain, share=0.5):
+    return {"observed": observed, "predicted": "END", "faceted_share": share, "static_batch": law,
+            "static_law": law, "static_grain": grain}
+
+
+def test_the_grain_form_check_passes_only_when_it_turns_sf_records_beyond_chance():
+    from mpm_warp.studies.report.field_strength import render_static_strength
+
+    def check(cases):
+        data = {"faceted": 0.5, "faceted_grains": ["FC", "DH"], "cases": cases, "environment": {}}
+        return [ln for ln in render_static_strength(data, None) if ln.startswith("- **Check, ")][0]
+
+    # 8 of 10 SF records turned against 0 of 10 END records: p = C(10,8) / C(20,8) (the whole tail), a pass
+    sf = [_static_case("SF", "END", "SF")] * 8 + [_static_case("SF", "END", "END")] * 2
+    end = [_static_case("END", "END", "END")] * 10
+    line = check(sf + end)
+    assert "**pass**" in line and "8 of the 10 SF records and 0 of the 10 END records" in line
+    assert "p = 0.00" in line
+    # the END records turned as often as the SF ones: the grain form cannot tell them apart, a fail
+    end = [_static_case("END", "END", "SF")] * 8 + [_static_case("END", "END", "END")] * 2
+    assert "**FAIL**" in check(sf + end) and "as often or more" in check(sf + end)
+    # 2 of 4 against 1 of 4: the right way round but within chance, open
+    line = check([_static_case("SF", "END", "SF")] * 2 + [_static_case("SF", "END", "END")] * 2
+                 + [_static_case("END", "END", "SF")] + [_static_case("END", "END", "END")] * 3)
+    assert "**open**" in line and "too few cases to tell" in line
+    # no SF record the law's strength left END: nothing to compare, open
+    assert "**open**" in check([_static_case("SF", "SF", "SF")] + end)

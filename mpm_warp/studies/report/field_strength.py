@@ -1,4 +1,5 @@
-"""Field cases with their slab's tensile strength scaled, a what-if on its law (benchmarks/field/strength.py)."""
+"""Field cases with their slab's tensile strength scaled, a what-if on its law (benchmarks/field/strength.py),
+and with faceted layers at their in-situ strength (``--faceted``)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from statistics import median
 from .core import section
 from .field_closure import CLASSES, _balanced
 from .field_rigid_base import _cut
-from .fmt import check_line, count, env_note, fx, spct, table
+from .fmt import check_line, count, env_note, fx, pct, spct, table
 
 
 def _to_sf(cases: list, cls: str, side: str) -> tuple[int, int]:
@@ -20,8 +21,39 @@ def _to_sf(cases: list, cls: str, side: str) -> tuple[int, int]:
 
 #: the section's own run: the largest draw, at a quarter of the law's strength
 MAIN = "field/results/strength/0.25_16/field_strength.json"
+#: the same draw with only the faceted layers weakened, to their in-situ strength (Jamieson and Johnston 1990)
+FACETED = "field/results/strength/faceted_0.5_16/field_strength.json"
 #: smaller draws (8 a class, the same seed: a draw of its own) at both factors, summarised beside it
-MORE = ("field/results/strength/0.5_8/field_strength.json", "field/results/strength/0.25_8/field_strength.json")
+MORE = (FACETED, "field/results/strength/0.5_8/field_strength.json",
+        "field/results/strength/0.25_8/field_strength.json")
+
+
+def _check(label: str, row: list, p: float | None) -> str:
+    """The pass line of one factor's row: SF records predicted SF more often than END records, beyond chance."""
+    passed = None if p is None or p > 0.05 else True
+    return check_line(label, "a larger share of the SF records than of the END records predicted SF, beyond chance "
+                             "(one-sided Fisher exact test, p <= 0.05)", passed,
+                      f"SF records {row[3]}, END records {row[2]}, ARR records {row[4]}, the law's strength in "
+                      f"brackets; p = {row[6]}" + ("; too few cases to tell" if passed is None else ""))
+
+
+def _faceted_lines(data: dict) -> list[str]:
+    """What the faceted draw adds: the faceted share of the slabs per observed class and weac's static rule with
+    the same strengths."""
+    ran = [c for c in data["cases"] if c["scaled"].get("status") == "ok"]
+    shares, static = [], []
+    for cls in CLASSES:
+        of = [c for c in ran if c["observed"] == cls]
+        if of:
+            share = median(c["faceted_share"] for c in of)
+            anyf = sum(c["faceted_share"] > 0 for c in of)
+            shares.append(f"{cls} {pct(share, 0)} ({anyf} of {len(of)} with any)")
+            static.append(f"{cls} {sum(c['scaled']['static_class'] == 'SF' for c in of)} of {len(of)} "
+                          f"({sum(c['law']['static_class'] == 'SF' for c in of)})")
+    return [f"- With only the faceted layers (primary grain {', '.join(data['faceted_grains'])}) at "
+            f"{fx(data['faceted'], 2)} of the law's strength: the slab's faceted share of its thickness, median by "
+            f"observed class, {'; '.join(shares)}. weac's static rule with the same strengths predicts SF in "
+            f"{'; '.join(static)} records (at the law's strength in brackets).", ""]
 
 
 def fisher_greater(a: int, n: int, b: int, m: int) -> float:
@@ -30,6 +62,13 @@ def fisher_greater(a: int, n: int, b: int, m: int) -> float:
     k = a + b
     total = math.comb(n + m, k)
     return sum(math.comb(n, i) * math.comb(m, k - i) for i in range(a, min(n, k) + 1)) / total
+
+
+def _factor(data: dict) -> str:
+    """The strength over the law's: ``"0.25"``, or ``"faceted layers 0.50"`` where only those were weakened."""
+    f = data.get("faceted", 1.0)
+    return fx(data["scale"], 2) if f == 1.0 else (
+        f"faceted layers {fx(f, 2)}" + ("" if data["scale"] == 1.0 else f", all {fx(data['scale'], 2)}"))
 
 
 def _summary(data: dict) -> list:
@@ -45,7 +84,7 @@ def _summary(data: dict) -> list:
     ba, _ = _balanced(ran, "scaled")
     (a, n), (b, m) = got["SF"], got["END"]
     p = fisher_greater(a, n, b, m) if n and m else None
-    row = [fx(data["scale"], 2), str(data["per_class"]), *cells, fx(ba, 2), fx(p, 2)]
+    row = [_factor(data), str(data["per_class"]), *cells, fx(ba, 2), fx(p, 2)]
     return row, p, a / n if n else None, b / m if m else None
 
 
@@ -77,19 +116,21 @@ def render_strength(data: dict, ctx) -> list[str]:
     row, p, share_sf, share_end = _summary(data)
     more = [f for f in MORE if ctx is not None and ctx.exists(f)]
     others = [ctx.load(f) for f in more]
-    passed = None if p is None or p > 0.05 else share_sf > share_end
-    out += ["", check_line(f"a slab {fx(s, 2)} times as strong breaks where the observer saw SF rather than END",
-                           "a larger share of the SF records than of the END records predicted SF, beyond chance "
-                           "(one-sided Fisher exact test, p <= 0.05)", passed,
-                           f"SF records {row[3]}, END records {row[2]}, ARR records {row[4]}, the law's strength in "
-                           f"brackets; p = {row[6]}" + ("; too few cases to tell" if passed is None else "")), ""]
+    out += ["", _check(f"a slab {fx(s, 2)} times as strong breaks where the observer saw SF rather than END", row, p)]
+    if FACETED in more:
+        fac = others[more.index(FACETED)]
+        frow, fp, _, _ = _summary(fac)
+        out += [_check(f"faceted slab layers at {fx(fac['faceted'], 2)} of the law's strength (in situ, Jamieson and "
+                       "Johnston 1990) break where the observer saw SF rather than END", frow, fp)]
+    out += [""]
     summary = [row] + [_summary(d)[0] for d in others]
     out += table(["strength over the law's", "cases a class", "END records predicted SF", "SF records predicted SF",
-                  "ARR records predicted SF", "balanced accuracy", "p, SF against END"],
-                 sorted(summary, key=lambda r: (-float(r[0]), int(r[1]))))
+                  "ARR records predicted SF", "balanced accuracy", "p, SF against END"], summary)
     out += ["", "Each count is of the records that ran, with the count at the law's strength in brackets."
-            + (" The smaller draws: the same command with `--scale`, `--per-class 8` and `--out` ("
+            + (" The other rows: the same command with `--scale`, `--faceted`, `--per-class` and `--out` ("
                + ", ".join(ctx.link(f) for f in more) + ")." if more else ""), ""]
+    if FACETED in more:
+        out += _faceted_lines(others[more.index(FACETED)])
     parts = []
     for side, name in (("law", "at the law's strength"), ("scaled", f"at {fx(s, 2)} of it")):
         ba, rec = _balanced(ran, side)
@@ -107,4 +148,58 @@ def render_strength(data: dict, ctx) -> list[str]:
         out += [f"- The runaway cut, where both ran away ({len(cuts)} cases): {spct(min(cuts))} to {spct(max(cuts))} "
                 f"(median {spct(median(cuts))}).", ""]
     out += [env_note(data)]
+    return out
+
+
+def _static_row(cases: list, cls: str) -> list:
+    """One observed class of the static study: cases, faceted share, and weac's static SF at both strengths."""
+    of = [c for c in cases if c["observed"] == cls]
+    return [cls, str(len(of)), pct(median(c["faceted_share"] for c in of), 0),
+            pct(sum(c["faceted_share"] for c in of) / len(of), 0), str(sum(c["faceted_share"] > 0 for c in of)),
+            str(sum(c["static_law"] == "SF" for c in of)), str(sum(c["static_grain"] == "SF" for c in of))]
+
+
+def _static_balanced(cases: list, key: str) -> tuple[float, dict]:
+    """weac's static rule's balanced accuracy under ``key`` (its classes are SF and END) and its recalls."""
+    return _balanced([{"observed": c["observed"], "x": {"predicted": c[key]}} for c in cases], "x")
+
+
+@section("field", "The slab's strength by grain form: weac's static rule on every scored column",
+         "field/results/field_static_strength.json",
+         lambda d: f"python benchmarks/field/static_strength.py DIR --faceted {d['faceted']:g}",
+         question="Does the grain form of the slab's snow tell SF from END? Faceted snow is about half as strong in "
+                  "tension as rounded snow of the same density in situ (Jamieson and Johnston 1990), which the "
+                  "density law leaves out.",
+         follows="The slab's strength: the same columns with a weaker slab")
+def render_static_strength(data: dict, ctx) -> list[str]:
+    cases = [c for c in data["cases"] if c["static_law"] is not None]
+    f = data["faceted"]
+    out = [f"Cases: every case the committed development-set batches scored ({len(cases)}), set up again from its "
+           "pit as the batch set it up. No MPM runs: weac's static rule (SF where the slab's largest tensile stress "
+           "at the recorded cut reaches its strength, docs/field.md) at the density law's strength (Sigrist 2006) "
+           f"and with every slab layer of faceted snow (primary grain {', '.join(data['faceted_grains'])}) at "
+           f"{fx(f, 2)} of it, nothing else changed. The faceted share is of the slab's thickness.", ""]
+    out += table(["observed", "cases", "faceted share, median", "faceted share, mean", "slabs with a faceted layer",
+                  "static SF, the law's strength", f"static SF, faceted at {fx(f, 2)}"],
+                 [_static_row(cases, cls) for cls in CLASSES if any(c["observed"] == cls for c in cases)])
+    turned = {cls: (sum(c["static_law"] != "SF" and c["static_grain"] == "SF" for c in cases if c["observed"] == cls),
+                    sum(c["static_law"] != "SF" for c in cases if c["observed"] == cls)) for cls in ("SF", "END")}
+    (a, n), (b, m) = turned["SF"], turned["END"]
+    p = fisher_greater(a, n, b, m) if n and m else None
+    sf, end = (a / n if n else 0.0), (b / m if m else 0.0)
+    passed = None if p is None else True if p <= 0.05 else (False if sf <= end else None)
+    why = (f"turned to SF: {a} of the {n} SF records and {b} of the {m} END records the law's strength left END; "
+           f"p = {fx(p, 2)}" + ("; weakening the faceted layers sends the END records to SF as often or more"
+                                if passed is False else "; too few cases to tell" if passed is None else ""))
+    out += ["", check_line("the grain form's strength tells SF from END in weac's static rule",
+                           "a larger share of the SF records than of the END records turned to SF by the faceted "
+                           "layers' strength, beyond chance (one-sided Fisher exact test, p <= 0.05)", passed, why), ""]
+    parts = []
+    for key, name in (("static_law", "at the law's strength"), ("static_grain", f"with faceted layers at {fx(f, 2)}")):
+        ba, rec = _static_balanced(cases, key)
+        parts.append(f"{name}: {fx(ba, 2)} (recall " + ", ".join(f"{k} {fx(v, 2)}" for k, v in rec.items()) + ")")
+    same = sum(c["static_law"] == c["static_batch"] for c in cases)
+    out += [f"- weac's static rule's balanced accuracy on these cases: {parts[0]}; {parts[1]}. At the law's strength "
+            f"it is the batch's baseline: the same class in {same} of {len(cases)} cases.", ""]
+    out += [env_note(data, verb="computed")]
     return out
