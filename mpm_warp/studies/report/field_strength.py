@@ -28,13 +28,15 @@ MORE = (FACETED, "field/results/strength/0.5_8/field_strength.json",
         "field/results/strength/0.25_8/field_strength.json")
 
 
-def _check(label: str, row: list, p: float | None) -> str:
-    """The pass line of one factor's row: SF records predicted SF more often than END records, beyond chance."""
-    passed = None if p is None or p > 0.05 else True
+def _check(label: str, row: list, p: float | None, sf: float | None, end: float | None) -> str:
+    """The pass line of one factor's row: SF records predicted SF more often than END records, beyond chance; a
+    fail where they are not predicted SF more often at all (shares ``sf`` and ``end``)."""
+    passed = None if p is None else True if p <= 0.05 else (False if sf <= end else None)
     return check_line(label, "a larger share of the SF records than of the END records predicted SF, beyond chance "
                              "(one-sided Fisher exact test, p <= 0.05)", passed,
                       f"SF records {row[3]}, END records {row[2]}, ARR records {row[4]}, the law's strength in "
-                      f"brackets; p = {row[6]}" + ("; too few cases to tell" if passed is None else ""))
+                      f"brackets; p = {row[6]}" + {None: "; too few cases to tell", True: "",
+                                                   False: "; no larger share of the SF records"}[passed])
 
 
 def _faceted_lines(data: dict) -> list[str]:
@@ -50,8 +52,10 @@ def _faceted_lines(data: dict) -> list[str]:
             shares.append(f"{cls} {pct(share, 0)} ({anyf} of {len(of)} with any)")
             static.append(f"{cls} {sum(c['scaled']['static_class'] == 'SF' for c in of)} of {len(of)} "
                           f"({sum(c['law']['static_class'] == 'SF' for c in of)})")
+    moved = sum(c["scaled"]["predicted"] != c["law"]["predicted"] for c in ran)
     return [f"- With only the faceted layers (primary grain {', '.join(data['faceted_grains'])}) at "
-            f"{fx(data['faceted'], 2)} of the law's strength: the slab's faceted share of its thickness, median by "
+            f"{fx(data['faceted'], 2)} of the law's strength, {moved} of the {len(ran)} runs changed their class. "
+            "The slab's faceted share of its thickness, median by "
             f"observed class, {'; '.join(shares)}. weac's static rule with the same strengths predicts SF in "
             f"{'; '.join(static)} records (at the law's strength in brackets).", ""]
 
@@ -116,12 +120,13 @@ def render_strength(data: dict, ctx) -> list[str]:
     row, p, share_sf, share_end = _summary(data)
     more = [f for f in MORE if ctx is not None and ctx.exists(f)]
     others = [ctx.load(f) for f in more]
-    out += ["", _check(f"a slab {fx(s, 2)} times as strong breaks where the observer saw SF rather than END", row, p)]
+    out += ["", _check(f"a slab {fx(s, 2)} times as strong breaks where the observer saw SF rather than END", row, p,
+                       share_sf, share_end)]
     if FACETED in more:
         fac = others[more.index(FACETED)]
-        frow, fp, _, _ = _summary(fac)
+        frow, *rest = _summary(fac)
         out += [_check(f"faceted slab layers at {fx(fac['faceted'], 2)} of the law's strength (in situ, Jamieson and "
-                       "Johnston 1990) break where the observer saw SF rather than END", frow, fp)]
+                       "Johnston 1990) break where the observer saw SF rather than END", frow, *rest)]
     out += [""]
     summary = [row] + [_summary(d)[0] for d in others]
     out += table(["strength over the law's", "cases a class", "END records predicted SF", "SF records predicted SF",
