@@ -31,7 +31,8 @@ COMPARING = {"Error against run time: the reference problems": 2,
              "The laminate closure: the same columns without and with it": 2,
              "The laminate closure: the slab's stress at the weak layer against the FE": 2,
              "The slab's strength: the same columns with a weaker slab": 2,
-             "The slab's strength by grain form: weac's static rule on every scored column": 1}
+             "The slab's strength by grain form: weac's static rule on every scored column": 1,
+             "The far end: the columns called END, run on past the call": 1}
 LINE = re.compile(r"^- \*\*Check, [^*]+:\*\* .+: \*\*(pass|FAIL|open)\*\*( \(.+\))?\.$")
 
 
@@ -200,3 +201,21 @@ def test_the_grain_form_check_passes_only_when_it_turns_sf_records_beyond_chance
     assert "**open**" in line and "too few cases to tell" in line
     # no SF record the law's strength left END: nothing to compare, open
     assert "**open**" in check([_static_case("SF", "SF", "SF")] + end)
+
+
+def test_the_far_end_check_fails_on_a_crack_that_stops_short_of_the_end():
+    from mpm_warp.studies.report.field_far_end import fate, render_far_end
+
+    def case(test, reached, stalled, last):
+        return {"id": test, "test": test, "observed": "ARR", "status": "ok", "call": "END", "call_front": 0.7,
+                "last_front": last, "reached": reached, "stalled": stalled, "runaway_cut": 0.6, "length": 1.0,
+                "end_zone": 0.4, "bin_width": 0.01, "steps": 10, "wall_s": 1.0, "batch": {"steps": 8, "wall_s": 1.0}}
+
+    data = {"chosen": "2 drawn", "end_bins": 2, "stall_time": 0.05, "per_class": 1, "seed": 0, "max_wall_s": 120,
+            "workers": 1, "environment": {}, "cases": [case("a", True, False, 0.995), case("b", False, True, 0.82)]}
+    assert [fate(c) for c in data["cases"]] == ["reached the end", "stopped short"]
+    line = [ln for ln in render_far_end(data, None) if ln.startswith("- **Check, ")][0]
+    assert "**FAIL**" in line and "1 of 2 reached the end" in line and "`b` (ARR) at 0.820 of 1.000 m" in line
+    data["cases"] = data["cases"][:1]
+    assert "**pass**" in [ln for ln in render_far_end(data, None) if ln.startswith("- **Check, ")][0]
+    assert fate({"status": "ok", "call": "SF"}) == "called SF" and fate({"status": "failed"}) == "failed"

@@ -40,7 +40,7 @@ from .table import table_profiles
 from .uncertainty import balanced_accuracy_intervals
 
 __all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "run_records", "case_digest",
-           "FieldBatch"]
+           "case_scenario", "FieldBatch"]
 
 
 @dataclass
@@ -173,17 +173,25 @@ def _static_cut(case: FieldCase) -> float | None:
     return critical_cut(static_column(p), p.weak_layer.w_f)
 
 
-def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
+def case_scenario(case: FieldCase, proto: FieldProtocol):
+    """The scenario a batch runs for ``case`` under ``proto`` and its setup note: ``(scenario, note)``, or
+    ``(None, reason)`` where the column exceeds the per-case budget. Building it calibrates the weak layer; an
+    InvalidArgument says what the model cannot represent."""
     from ..scenes.pst import build
 
+    params, tc, note = protocol_params(case.params, proto, _static_cut(case) if proto.pre_cut_share > 0.0 else None)
+    return (None, note) if params is None else (build(params, tc, name="field"), note)
+
+
+def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
     tasks = []
     for k, c in enumerate(cases):
         try:
-            params, tc, note = protocol_params(c.params, proto, _static_cut(c) if proto.pre_cut_share > 0.0 else None)
-            if params is None:
+            scenario, note = case_scenario(c, proto)
+            if scenario is None:
                 refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
                 continue
-            scenario = build(params, tc, name="field")          # calibrates the weak layer (once per column)
+            params = scenario.scene
         except InvalidArgument as e:
             refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, c.params), c.outcome))
             continue

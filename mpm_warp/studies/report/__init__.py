@@ -34,6 +34,7 @@ from . import (  # noqa: F401
     convergence,
     field,
     field_closure,
+    field_far_end,
     field_pre_cut,
     field_resolution,
     field_rigid_base,
