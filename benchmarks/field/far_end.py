@@ -31,6 +31,7 @@ from closure import add_draw_arguments, draw, matched_cases
 
 from mpm_warp.field.batch import case_scenario
 from mpm_warp.field.protocol import FieldProtocol
+from mpm_warp.io.records import write_record
 from mpm_warp.scenes.pst.analysis import end_zone
 from mpm_warp.scenes.pst.outcome import STALL_TIME
 from mpm_warp.studies.environment import environment, write_json
@@ -85,8 +86,7 @@ def _one(task: dict) -> dict:
         rec.update(status="ok", **run_past_end_call(task["scenario"], task["path"] + ".h5", task["end_bins"]))
     except Exception as e:      # recorded, never stops the others
         rec.update(status="failed", error=f"{type(e).__name__}: {e}")
-    with open(task["path"] + ".json", "w") as fh:
-        json.dump(rec, fh, default=str)
+    write_record(task["path"] + ".json", rec, "a far-end case record", default=str)   # atomic: a kill leaves none
     return rec
 
 
