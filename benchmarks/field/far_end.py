@@ -1,9 +1,9 @@
 """Does the crack reach the column's end where the model says END? The field columns run on past that call.
 
 The model says END once the damage front enters the far end zone, one slab thickness from the column's end
-(docs/model.md; there the slab's free end lifts the layer). In most field columns the recorded cut leaves less
-than a slab thickness of column beyond it, so END is called as soon as the crack runs away, where an observer
-writes END only if the crack reaches the end and ARR if it stops short of it. This study draws cases as
+(docs/model.md; there the slab's free end lifts the layer). Where the crack runs away within a slab thickness of
+the end, END is called as soon as it runs; an observer writes END only if the crack reaches the end and ARR if it
+stops short of it. This study draws cases as
 ``closure.py`` does (``--per-class`` of each observed class, ``--seed``, among the committed batches' cases of at
 most ``--max-wall`` s), keeps those the batch predicted END, sets each up again from its pit (its id's digest must
 match the batch's) and runs it by the field protocol, nothing changed, past the END call: until the damage front
@@ -33,7 +33,7 @@ from mpm_warp.field.batch import case_scenario
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.io.records import write_record
 from mpm_warp.scenes.pst.analysis import end_zone
-from mpm_warp.scenes.pst.outcome import STALL_TIME
+from mpm_warp.scenes.pst.outcome import STALL_TIME, front_stalled
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -64,10 +64,8 @@ def run_past_end_call(scenario, path: str, end_bins: int) -> dict:
             if o["class"] != "END":
                 return False                      # decided otherwise: the batch's stop
         p = mon.sawn()
-        recent = times >= times[-1] - STALL_TIME
         seen["reached"] = bool(front[-1] >= p.length - end_bins * p.bin_width - 1e-9)
-        seen["stalled"] = bool(times[-1] >= p.saw_end + STALL_TIME
-                               and front[recent].max() - front[recent].min() < p.bin_width)
+        seen["stalled"] = bool(front_stalled(times, front, p))   # the outcome's own test for an arrest
         return not (seen["reached"] or seen["stalled"])
 
     t0 = time.perf_counter()

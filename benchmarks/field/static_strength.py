@@ -24,7 +24,7 @@ import time
 import warnings
 
 from closure import BATCHES, matched_cases
-from strength import FACETED, faceted, weaker
+from strength import FACETED, faceted_share, weaker
 
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.field.static_rule import weac_static_class
@@ -33,12 +33,6 @@ from mpm_warp.studies.protocol import out_dir, parser
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
-
-
-def faceted_share(params) -> float:
-    """The share of the slab's thickness that is faceted snow (-)."""
-    layers = params.slab_stack()
-    return sum(ly.thickness for ly in layers if faceted(ly)) / sum(ly.thickness for ly in layers)
 
 
 def main(argv=None) -> int:

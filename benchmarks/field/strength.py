@@ -50,6 +50,12 @@ def faceted(layer) -> bool:
     return (layer.name or "").startswith(FACETED)
 
 
+def faceted_share(params) -> float:
+    """The share of a column's slab thickness that is faceted snow (-)."""
+    layers = params.slab_stack()
+    return sum(ly.thickness for ly in layers if faceted(ly)) / sum(ly.thickness for ly in layers)
+
+
 def weaker(case, scale: float, facets: float = 1.0):
     """``case`` with every slab layer's tensile strength ``scale`` times its density law's (Pa), ``facets`` times
     more for a layer of faceted snow, and nothing else changed; a layer given its own strength keeps it scaled the
@@ -86,10 +92,9 @@ def main(argv=None) -> int:
     chosen, records, meta = drawn
     rows = []
     for b, rec, case in zip(chosen, records, meta.pop("cases"), strict=True):
-        layers = case.params.slab_stack()
-        share = sum(ly.thickness for ly in layers if faceted(ly)) / sum(ly.thickness for ly in layers)
         rows.append({"id": b["id"], "scaled_id": rec["id"], "test": b["test"], "observed": b["observed"],
-                     "w_f": b["w_f"], "w_f_source": b["w_f_source"], "setup": b["setup"], "faceted_share": share,
+                     "w_f": b["w_f"], "w_f_source": b["w_f_source"], "setup": b["setup"],
+                     "faceted_share": faceted_share(case.params),
                      "law": {k: b.get(k) for k in KEYS + ("static_class",)},
                      "scaled": {k: rec.get(k) for k in KEYS + ("error",)} | {"static_class": weac_static_class(
                          case.params)}})

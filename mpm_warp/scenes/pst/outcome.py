@@ -30,7 +30,8 @@ import numpy as np
 from .analysis import crack_ran, end_zone
 from .params import PSTParams
 
-__all__ = ["SlabCrackDetector", "classify", "field_line", "CLASSES", "THROUGH_DAMAGE", "THROUGH_COVER", "STALL_TIME"]
+__all__ = ["SlabCrackDetector", "classify", "field_line", "front_stalled", "CLASSES", "THROUGH_DAMAGE", "THROUGH_COVER",
+           "STALL_TIME"]
 
 #: the classes of :func:`classify`: the field's three and no propagation (``saw.stop = "runaway"`` only)
 CLASSES = ("END", "SF", "ARR", "NP")
@@ -145,13 +146,13 @@ def classify(params: PSTParams, times, front, slab_crack=None, saw_cut: float | 
         out["slab_fracture_at"] = at_sf
     elif math.isfinite(t_end):
         cls = "END"
-    elif no_runaway and len(t) and _stalled(t, fr, params):
+    elif no_runaway and len(t) and front_stalled(t, fr, params):
         cls = "NP"
         out["note"] = (f"the saw reached its end, {float(params.saw.cut_length):.2f} m, without the crack running "
                        f"away from it by {params.front.runaway_lead:g} m")
         if math.isfinite(t_sf):
             out["note"] += f"; the slab then broke {at_sf:.2f} m from the cut end"
-    elif len(t) and _stalled(t, fr, params):
+    elif len(t) and front_stalled(t, fr, params):
         cls = "ARR"
         out["arrest_at"] = float(fr[-1])
         if fr[-1] <= float(params.saw.cut_length) + 2.0 * params.bin_width:
@@ -176,7 +177,7 @@ _NAN_REASONS = {"end_time": "the crack did not reach the far end zone, having ru
                 "arrest_at": "not an ARR outcome"}
 
 
-def _stalled(t, front, params: PSTParams) -> bool:
+def front_stalled(t, front, params: PSTParams) -> bool:
     """Whether the front has stood still for :data:`STALL_TIME` at the end of the series, after the saw stopped."""
     if t[-1] < params.saw_end + STALL_TIME:
         return False
