@@ -27,6 +27,7 @@ import time
 import warnings
 
 from mpm_warp.field.batch import case_digest, gather, run_cases
+from mpm_warp.field.cases import FieldCase
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -88,11 +89,12 @@ def add_draw_arguments(p, runs: str, per_class: int) -> None:
 
 def draw_and_run(args, name: str, env: dict, proto: FieldProtocol, run_proto: FieldProtocol, adjust=None):
     """The drawn cases (``add_draw_arguments``) set up again from their pits under ``proto`` (each must match its
-    batch's digest), changed by ``adjust(case)`` when given, and run under ``run_proto`` into ``args.runs`` (or a
-    temporary folder). Returns ``(chosen, records, meta)``: the batch rows drawn, the new runs' records in the same
-    order, and the fields every such study's JSON carries (``env``, the script's environment, recorded before the
-    runs) with ``dest`` (the JSON's folder) and ``cases`` (the cases run), which the caller pops; None when a case
-    does not match (said on stderr)."""
+    batch's digest), changed by ``adjust(case)`` when given (it may return a refusal: a column the change leaves
+    the model unable to take), and run under ``run_proto`` into ``args.runs`` (or a temporary folder). Returns
+    ``(chosen, records, meta)``: the batch rows drawn, the new runs' records in the same order
+    (:func:`aligned_records`), and the fields every such study's JSON carries (``env``, the script's environment,
+    recorded before the runs) with ``dest`` (the JSON's folder) and ``cases`` (the cases run, or their
+    refusals), which the caller pops; None when a case does not match (said on stderr)."""
     cap = 20.0 if args.quick else args.max_wall
     chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
     chosen = chosen[:1] if args.quick else chosen
@@ -105,8 +107,10 @@ def draw_and_run(args, name: str, env: dict, proto: FieldProtocol, run_proto: Fi
     cases = [adjust(c) for c in cases] if adjust is not None else cases
     setup_s = time.perf_counter() - t0
     dest = out_dir(args, RESULTS, name)
+    runnable = [c for c in cases if isinstance(c, FieldCase)]
     with tempfile.TemporaryDirectory(prefix=f"mpm_warp_{name}_") as tmp:
-        batch = run_cases(cases, [], args.runs or tmp, workers=args.workers, protocol=run_proto)
+        batch = run_cases(runnable, [], args.runs or tmp, workers=args.workers, protocol=run_proto)
+    records = aligned_records(cases, batch, run_proto)
     meta = {"batches": [os.path.relpath(b, HERE) for b in args.batches],
             "per_class": args.per_class, "seed": args.seed, "max_wall_s": cap,
             "chosen": f"{len(chosen)} drawn ({args.per_class} per observed class, seed {args.seed}) from the {pool} "
@@ -114,7 +118,23 @@ def draw_and_run(args, name: str, env: dict, proto: FieldProtocol, run_proto: Fi
             "runs": os.path.basename(os.path.normpath(args.runs)) if args.runs else None,
             "protocol": run_proto.run_key(), "threads": args.threads, "workers": args.workers, "setup_s": setup_s,
             "environment": env, "dest": dest, "cases": cases}
-    return chosen, batch.records, meta
+    return chosen, records, meta
+
+
+def aligned_records(cases: list, batch, proto: FieldProtocol) -> list[dict]:
+    """The run's record of each of ``cases`` (field cases, or refusals where a change left a column the model
+    cannot take), in their order: a refusal, or a case the batch refused when built (the particle budget, the
+    calibration), gets ``{"status": "refused", "error": <its line in field terms>}``."""
+    by_digest = {r["id"].rsplit("-", 1)[1]: r for r in batch.records}
+    why = {(r.pit, r.test): r.message for r in batch.refused}
+    out = []
+    for c in cases:
+        if not isinstance(c, FieldCase):
+            out.append({"id": None, "status": "refused", "error": c.message})
+        else:
+            out.append(by_digest.get(case_digest(c, proto)) or
+                       {"id": None, "status": "refused", "error": why.get((c.pit, c.test), "not run")})
+    return out
 
 
 def main(argv=None) -> int:
