@@ -70,6 +70,19 @@ def test_uncut_column_carries_its_overburden():
         assert np.max(np.abs(r.sigma[sel, 1] - exact)) < 3e-3 * above[-1]
 
 
+@pytest.mark.parametrize("plane, confinement", [("strain", 1.0 / 3.0), ("stress", 0.25)])
+def test_weak_layer_on_its_base_is_confined_along_the_bed(plane, confinement):
+    """Mid-column of an uncut 3 m column the thin weak layer, bonded to the rigid base, cannot stretch along the
+    bed, so its stress along the bed is its normal stress times nu/(1 - nu) in plane strain (no strain across the
+    column either) and times nu in plane stress (no stress across it): 1/3 and 1/4 at its nu = 0.25 (measured
+    within 0.3 %, at its top, where the slab shears it). The slab above can stretch over the soft layer, and does
+    not follow either."""
+    r = solve_column(LAYERED, WEAK, 3.0, 0.0, dx=0.02, plane=plane)
+    sel = (np.abs(r.x - 1.5) < 0.011) & (r.layer == -1)
+    ratio = r.sigma[sel, 0] / r.sigma[sel, 1]
+    assert np.max(np.abs(ratio - confinement)) < 5e-3 * confinement
+
+
 def test_sawn_slab_converges_under_refinement():
     """The peak surface stress of 20 cm of 120 kg/m^3 sawn 0.3 m on a 1 MPa weak layer, 2 m column: 1.42 kPa,
     the same to 0.2 % on 1 cm and 5 mm elements, 2.5 cm past the tip on the bedded side. A cantilever clamped at
@@ -86,7 +99,8 @@ def test_sawn_slab_converges_under_refinement():
 
 
 @pytest.mark.parametrize("kwargs, field", [({"cut": 2.0}, "cut"), ({"slope_angle": 70.0}, "slope_angle"),
-                                           ({"column_ends": "plumb"}, "column_ends"), ({"dx": 0.0}, "dx")])
+                                           ({"column_ends": "plumb"}, "column_ends"), ({"dx": 0.0}, "dx"),
+                                           ({"plane": "3d"}, "plane")])
 def test_bad_input_names_the_argument(kwargs, field):
     args = {"cut": 0.5, **kwargs}
     cut = args.pop("cut")

@@ -46,14 +46,14 @@ CORNER_M = 0.02
 MESHES = (0.01, 0.005)
 
 
-def fe_ratios(column, strengths, cut: float, dx: float) -> dict:
-    """The FE's slab stress over strength at ``cut`` (m) on elements of ``dx`` (m): the peak away from the crack
-    tip's corner and the end faces (and where: x from the cut end, depth, layer, sigma_xx, sigma_zz, sigma_xz),
-    per layer, and in those edge zones (``edges``)."""
+def fe_ratios(column, strengths, cut: float, dx: float, plane: str = "strain") -> dict:
+    """The FE's slab stress over strength at ``cut`` (m) on elements of ``dx`` (m), in plane strain or plane stress:
+    the peak away from the crack tip's corner and the end faces (and where: x from the cut end, depth, layer,
+    sigma_xx, sigma_zz, sigma_xz), per layer, and in those edge zones (``edges``)."""
     t0 = time.perf_counter()
     r = solve_column(column.slab, (column.weak_layer_thickness, column.weak_layer_E, column.weak_layer_nu),
                      column.length, cut, slope_angle=column.slope_angle, cut_from=column.cut_from,
-                     column_ends=column.column_ends, dx=dx)
+                     column_ends=column.column_ends, dx=dx, plane=plane)
     slab = r.layer >= 0
     ratio = np.where(slab, r.sigma_1 / np.asarray(strengths)[np.maximum(r.layer, 0)], -np.inf)
     slab_depth = sum(ly[0] for ly in column.slab)

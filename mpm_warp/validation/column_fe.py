@@ -1,4 +1,5 @@
-"""A static plane-strain finite-element solution of a sawn PST column: the slab's stresses with every layer resolved.
+"""A static plane-strain (or plane-stress) finite-element solution of a sawn PST column: the slab's stresses with every
+layer resolved.
 
 The column is the one weac sees (a layered slab on a weak layer on a rigid base, free ends, gravity on a slope, the
 weak layer removed over the cut), meshed with biquadratic (9-node) elements that carry a linear strain through
@@ -38,9 +39,12 @@ def _shape(xi: float, eta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.outer(nz, nx).ravel(), np.outer(nz, dx).ravel(), np.outer(dz, nx).ravel()
 
 
-def _elasticity(E: float, nu: float) -> np.ndarray:
-    """Plane-strain elasticity matrix (Pa) for (eps_xx, eps_zz, gamma_xz)."""
+def _elasticity(E: float, nu: float, plane: str = "strain") -> np.ndarray:
+    """Elasticity matrix (Pa) for (eps_xx, eps_zz, gamma_xz): plane strain (no strain across the column), or plane
+    stress (no stress across it: the in-plane Lame constant is then ``2 lam mu / (lam + 2 mu)``)."""
     lam, mu = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
+    if plane == "stress":
+        lam = 2.0 * lam * mu / (lam + 2.0 * mu)
     return np.array([[lam + 2 * mu, lam, 0.0], [lam, lam + 2 * mu, 0.0], [0.0, 0.0, mu]])
 
 
@@ -93,7 +97,7 @@ def _grid(thicknesses, cells_per_layer: int, dz_max: float) -> tuple[np.ndarray,
 
 def solve_column(slab, weak_layer, length: float, cut: float, *, slope_angle: float = 0.0,
                  cut_from: str = "upslope", column_ends: str = "slope_normal", dx: float = 0.01,
-                 cells_per_layer: int = 2, g: float = 9.81) -> ColumnFE:
+                 cells_per_layer: int = 2, g: float = 9.81, plane: str = "strain") -> ColumnFE:
     """Solve a sawn column statically.
 
     Parameters
@@ -111,6 +115,9 @@ def solve_column(slab, weak_layer, length: float, cut: float, *, slope_angle: fl
     dx : float
         Element width along the column (m); ``cells_per_layer`` elements at least through every layer, and
         none taller than ``dx``.
+    plane : {"strain", "stress"}
+        Plane strain (a column infinitely wide across the slope, as weac's and the run's) or plane stress (one
+        infinitely thin): a 30 cm wide field column lies between the two.
     """
     length = finite_number("length", length, lo=0.0, lo_open=True)
     cut = finite_number("cut", cut, lo=0.0, hi=length, hi_open=True)
@@ -120,6 +127,8 @@ def solve_column(slab, weak_layer, length: float, cut: float, *, slope_angle: fl
         raise InvalidArgument("cut_from", cut_from, '"upslope" or "downslope"')
     if column_ends not in ("slope_normal", "vertical"):
         raise InvalidArgument("column_ends", column_ends, '"slope_normal" or "vertical"')
+    if plane not in ("strain", "stress"):
+        raise InvalidArgument("plane", plane, '"strain" or "stress"')
     if not isinstance(cells_per_layer, int) or cells_per_layer < 1:
         raise InvalidArgument("cells_per_layer", cells_per_layer, "an integer >= 1")
     try:
@@ -150,7 +159,7 @@ def solve_column(slab, weak_layer, length: float, cut: float, *, slope_angle: fl
     for j in range(nez):
         t, rho, E, nu = layers[row_layer[j]]
         hz = zf[j + 1] - zf[j]
-        D = _elasticity(E, nu)
+        D = _elasticity(E, nu, plane)
         Ke, fe = np.zeros((18, 18)), np.zeros(18)
         for a, wa in zip(*_GAUSS, strict=True):
             for b, wb in zip(*_GAUSS, strict=True):

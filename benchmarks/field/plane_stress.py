@@ -1,0 +1,83 @@
+"""Is plane strain the slab's load in a 30 cm wide column? The static FE of every scored column in both plane limits.
+
+The run and weac both take a PST column as infinitely wide across the slope (plane strain); a field column is 30 cm
+wide, with free side walls, and its slab 10-100 cm deep, so it lies between plane strain and plane stress (a
+column infinitely thin). If that mattered to the slab's stress, it could be physics the model lacks where the
+observer saw the slab break. This study runs no MPM: every case the committed development-set batches scored
+(``--batches``) is set up again from its pit (its id's digest must match) and solved statically at its recorded
+cut, the cut the observer saw the crack start at, by the 9-node FE of ``slab_fe.py``
+(``mpm_warp.validation.column_fe``, elements ``--dx`` wide, every layer resolved), once in plane strain and once
+in plane stress. Per case: the slab's largest principal stress over its layer's tensile strength (Sigrist 2006,
+or as given), away from the singular corners (``slab_fe.CORNER_M``), in each limit, and where it sits. Writes
+``benchmarks/field/results/field_plane_stress.json``.
+
+Usage: ``python benchmarks/field/plane_stress.py DIR [--dx 0.01] [--batches JSON ...]``; ``--quick``: the first 3
+cases, to a temporary folder. Seconds a case.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+import warnings
+
+from closure import BATCHES, matched_cases
+from slab_fe import fe_ratios
+
+from mpm_warp.field.protocol import FieldProtocol
+from mpm_warp.scenes.pst.static import static_column
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "results")
+PLANES = ("strain", "stress")
+
+
+def main(argv=None) -> int:
+    p = parser(__doc__, "the first 3 cases")
+    p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
+    p.add_argument("--batches", nargs="+", default=list(BATCHES), help="field_batch.py JSONs (default: both committed)")
+    p.add_argument("--dx", type=float, default=0.01, help="element width (m, default 0.01)")
+    args = p.parse_args(argv)
+    if not 0.002 <= args.dx <= 0.05:
+        print(f"error: --dx = {args.dx:g} is invalid: expected 0.002-0.05 m", file=sys.stderr)
+        return 2
+    warnings.filterwarnings("ignore")
+    env = environment("cpu")
+    rows = {}
+    for b in args.batches:
+        for c in json.load(open(b))["cases"]:
+            if c.get("status") == "ok":
+                rows[c["id"]] = c
+    chosen = sorted(rows.values(), key=lambda c: c["id"])[: 3 if args.quick else None]
+    t0 = time.perf_counter()
+    cases, missing = matched_cases(args.data, [c["id"] for c in chosen], FieldProtocol().validate())
+    if missing:
+        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
+              file=sys.stderr)
+        return 2
+    out = []
+    for b, case in zip(chosen, cases, strict=True):
+        col = static_column(case.params)
+        strengths = [ly.strength for ly in case.params.slab_stack()]
+        cut = float(case.params.saw.cut_length)
+        fe = {plane: fe_ratios(col, strengths, cut, args.dx, plane) for plane in PLANES}
+        out.append({"id": b["id"], "test": b["test"], "observed": b["observed"], "predicted": b["predicted"],
+                    "static_class": b.get("static_class"), "cut": cut, "length": col.length,
+                    "slab_depth": sum(ly[0] for ly in col.slab), "fe": fe})
+        print(f"{b['test']} ({b['observed']}): peak {fe['strain']['peak']:.3f} (strain), "
+              f"{fe['stress']['peak']:.3f} (stress)", flush=True)
+    wall = time.perf_counter() - t0
+    data = {"name": "field_plane_stress", "dx": args.dx, "planes": list(PLANES),
+            "batches": [os.path.relpath(b, HERE) for b in args.batches], "wall_s": wall, "environment": env,
+            "cases": out}
+    path = write_json("field_plane_stress", data, out_dir(args, RESULTS, "field_plane_stress"))
+    print(f"{path}: {len(out)} cases in {wall:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
