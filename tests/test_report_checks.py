@@ -219,3 +219,60 @@ def test_the_far_end_check_fails_on_a_crack_that_stops_short_of_the_end():
     data["cases"] = data["cases"][:1]
     assert "**pass**" in [ln for ln in render_far_end(data, None) if ln.startswith("- **Check, ")][0]
     assert fate({"status": "ok", "call": "SF"}) == "called SF" and fate({"status": "failed"}) == "failed"
+
+
+def _plane_case(test, observed, strain, stress, static="END"):
+    return {"test": test, "observed": observed, "static_class": static,
+            "fe": {"strain": {"peak": strain}, "stress": {"peak": stress}}}
+
+
+def test_the_plane_stress_check_fails_where_one_column_moves_beyond_its_bound():
+    from mpm_warp.studies.report.field_plane_stress import ranks_above, render_plane_stress
+
+    # pairs (2, 1) and (3, 1) won, (2, 3) lost, (3, 3) tied: 2.5 of 4
+    assert ranks_above([2.0, 3.0], [1.0, 3.0]) == 0.625
+
+    def check(cases):
+        data = {"dx": 0.01, "cases": cases, "environment": {}}
+        return [ln for ln in render_plane_stress(data, None) if ln.startswith("- **Check, ")][0]
+
+    near = [_plane_case("a", "SF", 1.0, 0.97), _plane_case("b", "END", 0.5, 0.52)]
+    line = check(near)
+    assert "**pass**" in line and "2 of 2; median +0.5 %, from -3.0 % to +4.0 %" in line
+    line = check(near + [_plane_case("c", "ARR", 2.0, 1.6)])
+    assert "**FAIL**" in line and "2 of 3" in line and "the largest at `c` (2.00 in plane strain)" in line
+
+
+def _modulus_case(observed, scene, softer, status="ok"):
+    return {"test": f"PST {observed}", "observed": observed,
+            "scene": {"status": "ok", "predicted": scene, "static_class": "END", "w_f": 0.3, "w_f_source": "read back",
+                      "runaway_cut": 0.3, "steps": 10, "wall_s": 1.0},
+            "softer": {"status": status, "predicted": softer if status == "ok" else None, "static_class": "END",
+                       "w_f": 0.6, "w_f_source": "read back", "runaway_cut": 0.3, "slab_fracture_at": None,
+                       "steps": 12, "wall_s": 1.0, "error": None if status == "ok" else "p: PST 1/2 (SF) down 3 cm: x"}}
+
+
+def test_the_weak_modulus_check_asks_for_more_sf_among_the_sf_records_beyond_chance():
+    from mpm_warp.studies.report.field_weak_modulus import render_weak_modulus
+
+    def lines(cases):
+        data = {"scene_modulus_mpa": 1.0, "modulus_mpa": 0.25, "chosen": "n drawn", "per_class": 8, "seed": 0,
+                "max_wall_s": 120, "workers": 2, "threads": 1, "cases": cases, "environment": {}}
+        return render_weak_modulus(data, None)
+
+    def check(cases):
+        return [ln for ln in lines(cases) if ln.startswith("- **Check, ")][0]
+
+    sf = [_modulus_case("SF", "END", "SF")] * 8 + [_modulus_case("SF", "END", "END")] * 2
+    end = [_modulus_case("END", "END", "END")] * 10
+    assert "**pass**" in check(sf + end) and "SF records 8 of 10 (0)" in check(sf + end)
+    end = [_modulus_case("END", "END", "SF")] * 8 + [_modulus_case("END", "END", "END")] * 2
+    assert "**FAIL**" in check(sf + end) and "no larger share of the SF records" in check(sf + end)
+    few = [_modulus_case("SF", "END", "SF")] * 2 + [_modulus_case("SF", "END", "END")] * 2
+    few += [_modulus_case("END", "END", "SF")] + [_modulus_case("END", "END", "END")] * 3
+    assert "**open**" in check(few)
+    # a column the softer layer refuses is said in field terms and left out of the counts
+    out = lines(few + [_modulus_case("SF", "END", None, status="refused")])
+    assert "SF records 2 of 4 (0)" in [ln for ln in out if ln.startswith("- **Check, ")][0]
+    assert any(ln.startswith("- Not run on the softer layer (1): `PST SF` (SF): x.") for ln in out)
+    assert any("2.00 times the scene's (median; 2.00 to 2.00)" in ln for ln in out)
