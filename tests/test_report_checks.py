@@ -222,7 +222,7 @@ def test_the_far_end_check_fails_on_a_crack_that_stops_short_of_the_end():
 
 
 def _plane_case(test, observed, strain, stress, static="END"):
-    return {"test": test, "observed": observed, "static_class": static,
+    return {"test": test, "observed": observed, "static_class": static, "slab_depth": 0.3,
             "fe": {"strain": {"peak": strain}, "stress": {"peak": stress}}}
 
 
@@ -241,6 +241,10 @@ def test_the_plane_stress_check_fails_where_one_column_moves_beyond_its_bound():
     assert "**pass**" in line and "2 of 2; median +0.5 %, from -3.0 % to +4.0 %" in line
     line = check(near + [_plane_case("c", "ARR", 2.0, 1.6)])
     assert "**FAIL**" in line and "2 of 3" in line and "the largest at `c` (2.00 in plane strain)" in line
+    text = render_plane_stress({"dx": 0.01, "environment": {}, "cases": near + [_plane_case("c", "ARR", 2.0, 1.6)]},
+                               None)
+    assert any("raises the slab's peak by at most +4.0 % and lowers it in 2 of the 3 columns" in ln
+               and "Beyond 10 %: `c` (ARR, slab 30 cm deep, -20.0 %)." in ln for ln in text)
 
 
 def _modulus_case(observed, scene, softer, status="ok"):

@@ -63,6 +63,11 @@ def render_plane_stress(data: dict, ctx) -> list[str]:
     out += ["", check_line("plane strain against a 30 cm wide column",
                            f"the slab's peak stress at the recorded cut within {pct(WITHIN, 0)} between plane strain "
                            "and plane stress, in every column", passed, why), ""]
+    beyond = [f"`{c['test']}` ({c['observed']}, slab {fx(c['slab_depth'] * 100, 0)} cm deep, {spct(change(c))})"
+              for c in cases if abs(change(c)) > WITHIN]
+    out += [f"- Plane stress raises the slab's peak by at most {spct(max(ch))} and lowers it in "
+            f"{sum(x < 0.0 for x in ch)} of the {len(ch)} columns: a column narrower than plane strain's loads its "
+            "slab less, not more." + (f" Beyond {pct(WITHIN, 0)}: {'; '.join(beyond)}." if beyond else ""), ""]
     sf = [c["fe"]["strain"]["peak"] for c in cases if c["observed"] == "SF"]
     end = [c["fe"]["strain"]["peak"] for c in cases if c["observed"] == "END"]
     arr = [c["fe"]["strain"]["peak"] for c in cases if c["observed"] == "ARR"]
