@@ -55,6 +55,24 @@ def matched_cases(data: str, ids: list[str], proto: FieldProtocol) -> tuple[list
     return [c for c in found if c is not None], [i for i, c in zip(ids, found, strict=True) if c is None]
 
 
+def scored_cases(batches: list[str], data: str, limit: int | None = None) -> tuple[list[dict], list] | None:
+    """Every case the batches scored (their rows, by id; the first ``limit``), and each set up again from its pit in
+    ``data`` as its batch set it up (same order); None, said on stderr, when one is not set up as its batch set it
+    up."""
+    rows = {}
+    for b in batches:
+        for c in json.load(open(b))["cases"]:
+            if c.get("status") == "ok":
+                rows[c["id"]] = c
+    chosen = sorted(rows.values(), key=lambda c: c["id"])[:limit]
+    cases, missing = matched_cases(data, [c["id"] for c in chosen], FieldProtocol().validate())
+    if missing:
+        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
+              file=sys.stderr)
+        return None
+    return chosen, cases
+
+
 def draw(batches: list[str], per_class: int, seed: int, max_wall: float) -> tuple[list[dict], int]:
     """``per_class`` finished cases of each observed class, at random (``seed``), among the batches' cases whose
     run took at most ``max_wall`` s; and the size of that pool."""

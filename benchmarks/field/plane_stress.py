@@ -17,16 +17,14 @@ cases, to a temporary folder. Seconds a case.
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
 import warnings
 
-from closure import BATCHES, matched_cases
+from closure import BATCHES, scored_cases
 from slab_fe import fe_ratios
 
-from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.scenes.pst.static import static_column
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -47,18 +45,11 @@ def main(argv=None) -> int:
         return 2
     warnings.filterwarnings("ignore")
     env = environment("cpu")
-    rows = {}
-    for b in args.batches:
-        for c in json.load(open(b))["cases"]:
-            if c.get("status") == "ok":
-                rows[c["id"]] = c
-    chosen = sorted(rows.values(), key=lambda c: c["id"])[: 3 if args.quick else None]
     t0 = time.perf_counter()
-    cases, missing = matched_cases(args.data, [c["id"] for c in chosen], FieldProtocol().validate())
-    if missing:
-        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
-              file=sys.stderr)
+    scored = scored_cases(args.batches, args.data, 3 if args.quick else None)
+    if scored is None:
         return 2
+    chosen, cases = scored
     out = []
     for b, case in zip(chosen, cases, strict=True):
         col = static_column(case.params)
