@@ -55,6 +55,17 @@ def matched_cases(data: str, ids: list[str], proto: FieldProtocol) -> tuple[list
     return [c for c in found if c is not None], [i for i, c in zip(ids, found, strict=True) if c is None]
 
 
+def batch_cases(data: str, rows: list[dict], proto: FieldProtocol) -> list | None:
+    """:func:`matched_cases` of the batch ``rows``; None, said in one line on stderr, when one is not set up as its
+    batch set it up."""
+    cases, missing = matched_cases(data, [c["id"] for c in rows], proto)
+    if missing:
+        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
+              file=sys.stderr)
+        return None
+    return cases
+
+
 def scored_cases(batches: list[str], data: str, limit: int | None = None) -> tuple[list[dict], list] | None:
     """Every case the batches scored (their rows, by id; the first ``limit``), and each set up again from its pit in
     ``data`` as its batch set it up (same order); None, said on stderr, when one is not set up as its batch set it
@@ -65,12 +76,8 @@ def scored_cases(batches: list[str], data: str, limit: int | None = None) -> tup
             if c.get("status") == "ok":
                 rows[c["id"]] = c
     chosen = sorted(rows.values(), key=lambda c: c["id"])[:limit]
-    cases, missing = matched_cases(data, [c["id"] for c in chosen], FieldProtocol().validate())
-    if missing:
-        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
-              file=sys.stderr)
-        return None
-    return chosen, cases
+    cases = batch_cases(data, chosen, FieldProtocol().validate())
+    return None if cases is None else (chosen, cases)
 
 
 def draw(batches: list[str], per_class: int, seed: int, max_wall: float) -> tuple[list[dict], int]:
@@ -117,10 +124,8 @@ def draw_and_run(args, name: str, env: dict, proto: FieldProtocol, run_proto: Fi
     chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
     chosen = chosen[:1] if args.quick else chosen
     t0 = time.perf_counter()
-    cases, missing = matched_cases(args.data, [c["id"] for c in chosen], proto)
-    if missing:
-        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
-              file=sys.stderr)
+    cases = batch_cases(args.data, chosen, proto)
+    if cases is None:
         return None
     cases = [adjust(c) for c in cases] if adjust is not None else cases
     setup_s = time.perf_counter() - t0

@@ -27,7 +27,7 @@ import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
 
-from closure import add_draw_arguments, draw, matched_cases
+from closure import add_draw_arguments, batch_cases, draw
 
 from mpm_warp.field.batch import case_scenario
 from mpm_warp.field.protocol import FieldProtocol
@@ -99,10 +99,8 @@ def main(argv=None) -> int:
     chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
     ends = [c for c in chosen if c["predicted"] == "END"][: 1 if args.quick else None]
     proto = FieldProtocol().validate()
-    cases, missing = matched_cases(args.data, [c["id"] for c in ends], proto)
-    if missing:
-        print(f"error: data: {len(missing)} cases are not set up as their batch set them up (e.g. {missing[0]})",
-              file=sys.stderr)
+    cases = batch_cases(args.data, ends, proto)
+    if cases is None:
         return 2
     dest = out_dir(args, RESULTS, "field_far_end")
     with tempfile.TemporaryDirectory(prefix="mpm_warp_far_end_") as tmp:

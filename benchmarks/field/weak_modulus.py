@@ -27,10 +27,9 @@ import warnings
 
 from closure import KEYS, add_draw_arguments, draw_and_run
 
-from mpm_warp.field.cases import FieldCase, field_case
+from mpm_warp.field.cases import FieldCase, field_base, field_case
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.scenes.profile import read_profile
-from mpm_warp.scenes.pst import PSTParams, Saw
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import parser
 
@@ -42,7 +41,7 @@ def softer(case: FieldCase, data: str, modulus: float):
     """``case`` set up again from its pit in ``data`` with the weak layer's Young's modulus ``modulus`` (Pa), as the
     batch sets a column up (the fracture energy read back, the layer calibrated): a FieldCase, or the FieldRefusal
     that says why the model cannot take it. Nothing but the weak layer may change (checked)."""
-    base = PSTParams(slab_fracture=True, saw=Saw(cut_from="upslope"))
+    base = field_base()
     base = dataclasses.replace(base, weak_layer=dataclasses.replace(base.weak_layer, E=modulus))
     new = field_case(read_profile(os.path.join(data, case.pit)), case.record, base=base)
     if isinstance(new, FieldCase) and dataclasses.replace(new.params, weak_layer=case.params.weak_layer) != case.params:
@@ -78,7 +77,7 @@ def main(argv=None) -> int:
     dest = meta.pop("dest")
     meta.pop("cases")
     data = {"name": "field_weak_modulus", "modulus_mpa": args.modulus,
-            "scene_modulus_mpa": PSTParams().weak_layer.E / 1e6, **meta, "cases": rows}
+            "scene_modulus_mpa": field_base().weak_layer.E / 1e6, **meta, "cases": rows}
     path = write_json("field_weak_modulus", data, dest)
     print(f"{path}: {len(rows)} cases")
     return 0

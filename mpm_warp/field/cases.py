@@ -23,7 +23,7 @@ from ..scenes.snowpack import SnowLayer
 from .fracture_energy import ImpliedFractureEnergy, implied_fracture_energy
 from .plain_words import in_field_terms
 
-__all__ = ["FieldCase", "FieldRefusal", "field_case", "field_cases", "OUTCOMES", "column_ends_for"]
+__all__ = ["FieldCase", "FieldRefusal", "field_case", "field_cases", "field_base", "OUTCOMES", "column_ends_for"]
 
 OUTCOMES = ("End", "SF", "Arr")
 #: countries whose standard PST has vertical ends (the North American guidelines, Greene et al. 2016)
@@ -70,6 +70,12 @@ class FieldCase:
         w = (f"w_f {wf.value:.3g} J/m^2 ({how})" if wf.value is not None else
              f"w_f {self.params.weak_layer.w_f:g} J/m^2, the default: {wf.reason}")
         return f"{self.pit}: {self.test}: {describe(self.column)}; {w}"
+
+
+def field_base() -> PSTParams:
+    """What a field column takes where the profile says nothing (the weak layer's E, nu, strength, collapse; the
+    saw): a PST whose slab can break, sawn from the upslope end."""
+    return PSTParams(slab_fracture=True, saw=Saw(cut_from="upslope"))
 
 
 def column_ends_for(country: str | None) -> str:
@@ -134,8 +140,8 @@ def field_case(profile: SnowProfileData, rec: PSTRecord, *, base: PSTParams | No
     rec : PSTRecord
         One of ``profile.pst_tests``.
     base : PSTParams, optional
-        What the profile does not give (the weak layer's E, nu, strength, collapse; the saw); default: a
-        PSTParams with a slab that can break.
+        What the profile does not give (the weak layer's E, nu, strength, collapse; the saw); default
+        :func:`field_base`.
     calibrate : bool
         Calibrate the weak layer under this slab (as building the scene does): a column the calibration refuses
         is refused here.
@@ -159,7 +165,7 @@ def field_case(profile: SnowProfileData, rec: PSTRecord, *, base: PSTParams | No
             f"the column ({rec.column_length * 100:.0f} cm) is not longer than the slab is deep "
             f"({slab_normal * 100:.0f} cm, normal to the slope): the model counts a crack as at the far end within one "
             "slab depth of it, so such a column leaves the crack no room to run"))
-    base = base if base is not None else PSTParams(slab_fracture=True, saw=Saw(cut_from="upslope"))
+    base = base if base is not None else field_base()
     params, notes = None, list(col.notes)
     try:
         params = _params(profile, rec, col, base).validate("scene")

@@ -28,10 +28,16 @@ MORE = (FACETED, "field/results/strength/0.5_8/field_strength.json",
         "field/results/strength/0.25_8/field_strength.json")
 
 
-def _check(label: str, row: list, p: float | None, sf: float | None, end: float | None) -> str:
-    """The pass line of one factor's row: SF records predicted SF more often than END records, beyond chance; a
-    fail where they are not predicted SF more often at all (shares ``sf`` and ``end``)."""
-    passed = None if p is None else True if p <= 0.05 else (False if sf <= end else None)
+def sf_verdict(a: int, n: int, b: int, m: int) -> tuple[float | None, bool | None]:
+    """``(p, passed)`` of "SF in ``a`` of ``n`` SF records is a larger share than in ``b`` of ``m`` END records,
+    beyond chance": one-sided Fisher p (None without both), a pass at p <= 0.05, a fail where the SF records' share
+    is no larger at all, else open (None)."""
+    p = fisher_greater(a, n, b, m) if n and m else None
+    return p, None if p is None else True if p <= 0.05 else (False if a / n <= b / m else None)
+
+
+def _check(label: str, row: list, p: float | None, passed: bool | None) -> str:
+    """The pass line of one factor's row (:func:`sf_verdict`)."""
     return check_line(label, "a larger share of the SF records than of the END records predicted SF, beyond chance "
                              "(one-sided Fisher exact test, p <= 0.05)", passed,
                       f"SF records {row[3]}, END records {row[2]}, ARR records {row[4]}, the law's strength in "
@@ -87,9 +93,9 @@ def _summary(data: dict) -> list:
         cells.append(f"{k} of {n} ({k0})")
     ba, _ = _balanced(ran, "scaled")
     (a, n), (b, m) = got["SF"], got["END"]
-    p = fisher_greater(a, n, b, m) if n and m else None
+    p, passed = sf_verdict(a, n, b, m)
     row = [_factor(data), str(data["per_class"]), *cells, fx(ba, 2), fx(p, 2)]
-    return row, p, a / n if n else None, b / m if m else None
+    return row, p, passed
 
 
 @section("field", "The slab's strength: the same columns with a weaker slab", MAIN,
@@ -117,11 +123,11 @@ def render_strength(data: dict, ctx) -> list[str]:
     out += table(["record", "observed", "predicted", "runaway cut (m)", "slab broke at (m), weaker",
                   "steps", "wall time, s (threads)"], rows)
     ran = [c for c in cases if c["scaled"].get("status") == "ok"]
-    row, p, share_sf, share_end = _summary(data)
+    row, p, passed = _summary(data)
     more = [f for f in MORE if ctx is not None and ctx.exists(f)]
     others = [ctx.load(f) for f in more]
     out += ["", _check(f"a slab {fx(s, 2)} times as strong breaks where the observer saw SF rather than END", row, p,
-                       share_sf, share_end)]
+                       passed)]
     if FACETED in more:
         fac = others[more.index(FACETED)]
         frow, *rest = _summary(fac)
@@ -190,9 +196,7 @@ def render_static_strength(data: dict, ctx) -> list[str]:
     turned = {cls: (sum(c["static_law"] != "SF" and c["static_grain"] == "SF" for c in cases if c["observed"] == cls),
                     sum(c["static_law"] != "SF" for c in cases if c["observed"] == cls)) for cls in ("SF", "END")}
     (a, n), (b, m) = turned["SF"], turned["END"]
-    p = fisher_greater(a, n, b, m) if n and m else None
-    sf, end = (a / n if n else 0.0), (b / m if m else 0.0)
-    passed = None if p is None else True if p <= 0.05 else (False if sf <= end else None)
+    p, passed = sf_verdict(a, n, b, m)
     why = (f"turned to SF: {a} of the {n} SF records and {b} of the {m} END records the law's strength left END; "
            f"p = {fx(p, 2)}" + ("; weakening the faceted layers sends the END records to SF as often or more"
                                 if passed is False else "; too few cases to tell" if passed is None else ""))

@@ -7,7 +7,7 @@ from statistics import median
 from .core import section
 from .field_closure import CLASSES, _balanced
 from .field_rigid_base import _cut
-from .field_strength import fisher_greater
+from .field_strength import sf_verdict
 from .fmt import check_line, count, env_note, fx, table
 
 
@@ -59,9 +59,7 @@ def render_weak_modulus(data: dict, ctx) -> list[str]:
     got = {cls: _sf(ran, cls, "softer") for cls in CLASSES}
     was = {cls: _sf(ran, cls, "scene") for cls in CLASSES}
     (a, n), (b, m) = got["SF"], got["END"]
-    p = fisher_greater(a, n, b, m) if n and m else None
-    share_sf, share_end = (a / n if n else 0.0), (b / m if m else 0.0)
-    passed = None if p is None else True if p <= 0.05 else (False if share_sf <= share_end else None)
+    p, passed = sf_verdict(a, n, b, m)
     why = (", ".join(f"{cls} records {got[cls][0]} of {got[cls][1]} ({was[cls][0]})" for cls in CLASSES)
            + f", at the scene's modulus in brackets; p = {fx(p, 2)}"
            + {None: "; too few cases to tell", True: "", False: "; no larger share of the SF records"}[passed])
