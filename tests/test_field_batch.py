@@ -70,10 +70,19 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     assert all(r["status"] == "ok" for r in again.records)
     assert [r["observed"] for r in again.records] == ["END", "ARR"]
     assert all(r["predicted"] in ("END", "SF", "ARR", "NP", "running") for r in again.records)
+    # each record carries the slab's peak stress over its strength, the model's probabilities from it, weac's peak
+    # ratio at the recorded cut and the information bar's numbers (the 12 cm cut of a 40 cm column: 0.3)
+    for r in again.records:
+        assert r["slab_peak_stress_ratio"] > 0.0 and r["static_peak_ratio"] > 0.0
+        assert r["p_end"] + r["p_sf"] + r["p_arr"] == pytest.approx(1.0)
+        assert r["slab_depth"] == pytest.approx(0.15) and r["slab_density"] == pytest.approx(180.0)
+    assert again.records[0]["cut_share"] == pytest.approx(0.3)
     # the files a reader gets: the cases, the refusals, the scores of the model and its baselines, the figure
     with open(os.path.join(out, "scores.json")) as fh:
         sc = json.load(fh)
-    assert sc["cases"] == 2 and set(sc) >= {"model", "majority", "weac_static", "wall_s"}
+    assert sc["cases"] == 2 and set(sc) >= {"model", "majority", "weac_static", "wall_s", "forecast"}
+    assert set(sc["forecast"]) >= {"model", "climatology", "majority", "weac_static"}
+    assert "cross-validate" in sc["forecast_missing"]["information_bar"]      # one pit, one case a class
     assert sc == json.loads(json.dumps(score_records(again.records)))
     assert [(g["threads"], g["workers"], g["cases"]) for g in sc["wall_s_by_config"]] == [(1, 1, 1), (2, 1, 1)]
     assert sc["wall_s_by_config"][1]["median"] == again.records[1]["wall_s"]

@@ -22,7 +22,6 @@ import glob
 import hashlib
 import json
 import os
-import statistics
 import sys
 import time
 import traceback
@@ -33,11 +32,12 @@ from .. import io
 from ..errors import InvalidArgument
 from .cases import FieldCase, FieldRefusal, field_case, field_cases
 from .plain_words import in_field_terms
+from .probability import outcome_probability
 from .protocol import FieldProtocol, decided, protocol_params
-from .scores import baseline_majority, field_class, scores
-from .static_rule import weac_static_class
+from .scores import field_class
+from .scoring import score_records
+from .static_rule import weac_static_rule
 from .table import table_profiles
-from .uncertainty import balanced_accuracy_intervals
 
 __all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "run_records", "case_digest",
            "case_scenario", "FieldBatch"]
@@ -88,6 +88,21 @@ def case_digest(case: FieldCase, proto: FieldProtocol) -> str:
     return hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
+#: what a case record says of the observer's column: the information bar's numbers (:mod:`.information_bar`)
+CASE_FEATURES = ("slab_depth", "slab_density", "slope_deg", "column_length", "cut_share")
+
+
+def case_record_features(case: FieldCase) -> dict:
+    """The column's bed-normal slab depth (m), mean slab density (kg/m^3), slope (deg), column length (m) and
+    recorded cut over column length (-): :data:`CASE_FEATURES`."""
+    p = case.params
+    slab = p.slab_stack()
+    depth = sum(ly.thickness for ly in slab)
+    return {"slab_depth": float(depth), "slab_density": sum(ly.thickness * ly.density for ly in slab) / depth,
+            "slope_deg": float(p.slope_angle), "column_length": float(p.length),
+            "cut_share": float(case.record.cut_length) / float(p.length)}
+
+
 def _case_id(case: FieldCase, k: int, proto: FieldProtocol) -> str:
     stem = os.path.splitext(case.pit)[0].replace("#", "-").replace(" ", "_")
     return f"{stem}-{k}-{case_digest(case, proto)}"
@@ -107,8 +122,8 @@ def run_case(task: dict) -> dict:
 
     t0 = time.perf_counter()
     out = os.path.join(task["out_dir"], task["id"])
-    rec = {k: task[k] for k in ("id", "pit", "test", "observed", "recorded_cut", "static_class", "w_f",
-                                 "w_f_source", "setup")}
+    rec = {k: task[k] for k in ("id", "pit", "test", "observed", "recorded_cut", "static_class", "static_peak_ratio",
+                                 "w_f", "w_f_source", "setup", *CASE_FEATURES)}
     rec["status"] = "failed"
     used = {}
 
@@ -123,9 +138,13 @@ def run_case(task: dict) -> dict:
         rec.update(status="ok", predicted=o.get("class") or "running", field_line=o.get("field_line"),
                    runaway_cut=_finite(res.scene_result.get("runaway_cut")),
                    slab_fracture_at=_finite(o.get("slab_fracture_at")), note=o.get("note", ""),
+                   slab_peak_stress_ratio=_finite(o.get("slab_peak_stress_ratio")),
                    sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
                    threads=used.get("threads"), workers=task.get("workers"),
                    n_frames=io.read_run(out + ".part.h5").n_frames)
+        prob = outcome_probability(rec["predicted"], rec["slab_peak_stress_ratio"])
+        if prob is not None:
+            rec["p_end"], rec["p_sf"], rec["p_arr"] = prob
         io.promote_part(out)
         rec["run_file"] = os.path.basename(out + ".h5")
     except Exception as e:      # a failing case is recorded with its error; it never stops the batch
@@ -196,8 +215,10 @@ def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
             refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, c.params), c.outcome))
             continue
         wf = c.fracture_energy
+        static = weac_static_rule(c.params)
         tasks.append({"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
-                      "recorded_cut": c.record.cut_length, "static_class": weac_static_class(c.params),
+                      "recorded_cut": c.record.cut_length, **case_record_features(c),
+                      "static_class": static["class"], "static_peak_ratio": static["peak_ratio"],
                       "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
                       "setup": note, "scenario": scenario, "out_dir": out_dir,
                       "device": device, "threads": proto.threads})
@@ -297,8 +318,9 @@ def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None =
 
 
 #: the columns of cases.csv
-CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "static_class", "recorded_cut", "runaway_cut",
-                "slab_fracture_at", "w_f", "w_f_source", "setup", "particles", "steps", "threads", "workers", "wall_s",
+CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "p_end", "p_sf", "p_arr", "static_class",
+                "static_peak_ratio", "recorded_cut", "runaway_cut", "slab_fracture_at", "slab_peak_stress_ratio",
+                *CASE_FEATURES, "w_f", "w_f_source", "setup", "particles", "steps", "threads", "workers", "wall_s",
                 "run_file", "error")
 
 
@@ -311,27 +333,3 @@ def _write_outputs(out_dir: str, recs: list, refused: list) -> None:
         w = csv.writer(fh)
         w.writerow(["pit", "test", "outcome", "reason", "message"])
         w.writerows([r.pit, r.test, r.outcome or "", r.reason, r.message] for r in refused)
-
-
-def score_records(recs: list) -> dict:
-    """Scores of the model and of the baselines on the cases that ran (``status`` ok, an observed class)."""
-    ok = [r for r in recs if r.get("status") == "ok" and r.get("observed")]
-    obs = [r["observed"] for r in ok]
-    pred = {"model": [r["predicted"] for r in ok], "majority": baseline_majority(obs),
-            "weac_static": [r.get("static_class") or "none" for r in ok]}
-    return {"cases": len(ok), "failed": sum(r.get("status") != "ok" for r in recs),
-            **{name: scores(obs, p) for name, p in pred.items()},
-            "uncertainty": balanced_accuracy_intervals(obs, pred, reference="model"),
-            "wall_s": {"median": statistics.median(walls) if (walls := [r["wall_s"] for r in ok]) else None,
-                       "total": sum(r["wall_s"] for r in ok)},
-            "wall_s_by_config": wall_by_config(ok)}
-
-
-def wall_by_config(recs: list) -> list[dict]:
-    """The median wall time (s) of the cases by how they ran: threads per case and Dask workers side by side
-    (None where a record from before this was kept does not say)."""
-    groups = {}
-    for r in recs:
-        groups.setdefault((r.get("threads"), r.get("workers")), []).append(r["wall_s"])
-    return [{"threads": t, "workers": w, "cases": len(v), "median": statistics.median(v)}
-            for (t, w), v in sorted(groups.items(), key=lambda kv: (kv[0][0] or 0, kv[0][1] or 0))]

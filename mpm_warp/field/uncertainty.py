@@ -14,7 +14,16 @@ import numpy as np
 
 from .scores import FIELD_CLASSES, scores
 
-__all__ = ["balanced_accuracy_intervals"]
+__all__ = ["balanced_accuracy_intervals", "stratified_resamples"]
+
+
+def stratified_resamples(observed: list[str], resamples: int, seed: int) -> list[np.ndarray]:
+    """Per observed class present, an index array (resamples, n_class) of its cases drawn with replacement (seeded):
+    every resample keeps each class's count."""
+    obs = np.asarray(observed, dtype=object)
+    members = [m for m in (np.flatnonzero(obs == c) for c in FIELD_CLASSES) if len(m)]
+    rng = np.random.default_rng(seed)
+    return [m[rng.integers(0, len(m), size=(resamples, len(m)))] for m in members]
 
 
 def _balanced(hits: np.ndarray, groups: list[np.ndarray]) -> np.ndarray:
@@ -56,12 +65,9 @@ def balanced_accuracy_intervals(observed: list[str], predictions: dict[str, list
         raise ValueError(f"resamples = {resamples} (at least 100) and level = {level} (in (0, 1))")
     out = {"level": level, "resamples": resamples, "seed": seed, "intervals": {}, "differences": {}}
     obs = np.asarray(observed, dtype=object)
-    members = [np.flatnonzero(obs == c) for c in FIELD_CLASSES]
-    members = [m for m in members if len(m)]
-    if not members:
+    groups = stratified_resamples(observed, resamples, seed)
+    if not groups:
         return out
-    rng = np.random.default_rng(seed)
-    groups = [m[rng.integers(0, len(m), size=(resamples, len(m)))] for m in members]
     tail = 100.0 * (1.0 - level) / 2.0
     values = {}
     for name, pred in predictions.items():
