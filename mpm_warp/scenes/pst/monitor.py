@@ -108,6 +108,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         u = {"front": "m", "deflection_front": "m", "saw": "m", "collapse_height": "m", "touchdown": "m"}
         if self.slab_crack is not None:
             u["slab_crack"] = "m"
+            u["slab_stress_ratio"] = "-"
         for k in range(len(self.markers)):
             u[f"marker{k}_ux"] = "m"
             u[f"marker{k}_uy"] = "m"
@@ -126,6 +127,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
                "deflection_front": deflection, "saw": self.saw_position(t)}
         if self.slab_crack is not None:
             out["slab_crack"] = self.slab_crack.through_crack()
+            out["slab_stress_ratio"] = self.slab_crack.stress_ratio()
         c, sawn = self.weak.collapse()
         gone = (self.weak.bond() <= 0.0) & (sawn == 0) & self.interior
         out["collapse_height"] = float(np.mean(c[gone]) * p.weak_layer_thickness) if gone.any() else 0.0
@@ -193,6 +195,9 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
 
     def _classify(self, times, series: dict, runaway: float) -> dict:
         out = classify(self.sawn(), times, series.get("front", []), series.get("slab_crack"), runaway)
+        ratio = np.asarray(series.get("slab_stress_ratio", []), dtype=float)
+        if ratio.size and np.isfinite(ratio).any():     # the slab's peak over its strength at the frames so far
+            out["slab_peak_stress_ratio"] = float(np.nanmax(ratio))
         out.update(stop_record(self.params, self.stopped_at, runaway))
         return out
 

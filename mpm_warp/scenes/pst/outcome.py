@@ -71,6 +71,22 @@ class SlabCrackDetector:
         """Damage (-) of the slab's particles, in the order of :attr:`groups`."""
         return np.concatenate([g.material.damage(g.kappa.numpy()) for g in self.groups])
 
+    def stress_ratio(self) -> float:
+        """The slab's largest tensile stress over its layer's strength now (-): the largest principal Kirchhoff
+        stress of the Hencky strain of ``F_E`` (the in-plane ones in 2D, where ``F_E,zz = 1``) over intact
+        particles, or the largest ``kappa`` (the effective stress a cracking particle reached) where larger."""
+        best = 0.0
+        for g in self.groups:
+            m = g.material
+            H = g.H.numpy().astype(np.float64)
+            F = H + np.eye(H.shape[1])
+            b = np.einsum("nij,nkj->nik", F, F)
+            eps = 0.5 * np.log(np.clip(np.linalg.eigvalsh(b), 1e-300, None))      # principal Hencky strains
+            s1 = (2.0 * m.mu * eps + m.lam * eps.sum(axis=1, keepdims=True)).max(axis=1)
+            kappa = g.kappa.numpy().astype(np.float64)
+            best = max(best, float(np.max(np.maximum(s1, kappa), initial=0.0)) / m.tensile_strength)
+        return best
+
     def through_crack(self) -> float:
         """Position (m from the cut end) of the first crack through the slab, nan if there is none."""
         cracked = self.damage() >= THROUGH_DAMAGE
