@@ -16,46 +16,25 @@ selection on 2 cores.
 from __future__ import annotations
 
 import os
-import random
 import sys
 import tempfile
 import time
 import warnings
 
-from mpm_warp.field.batch import FieldBatch, finished_records, gather, run_cases, score_records
+from mpm_warp.field.batch import CASE_FEATURES, FieldBatch, finished_records, gather, run_cases, score_records
+from mpm_warp.field.draw import select
 from mpm_warp.field.protocol import FieldProtocol
-from mpm_warp.field.scores import field_class
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 
-def all_measured(case) -> bool:
-    """Every slab layer's density was measured in the pit."""
-    return all(p.measured for p in case.column.slab)
-
-
 #: each case's keys in the JSON
-CASE_KEYS = ("id", "test", "observed", "predicted", "static_class", "recorded_cut", "runaway_cut", "w_f", "w_f_source",
-             "setup", "particles", "steps", "threads", "workers", "wall_s", "status", "error")
-
-
-def select(cases, per_class: int, seed: int, measured: bool = True) -> tuple[list, dict]:
-    """The measured-density columns (when ``measured``) and a seeded sample of ``per_class`` per observed class."""
-    chosen = [c for c in cases if measured and all_measured(c)]
-    rest = [c for c in cases if not (measured and all_measured(c))]
-    rng = random.Random(seed)
-    counts = {"measured": len(chosen)}
-    takes = []
-    for cls in ("END", "SF", "ARR"):
-        pool = [c for c in rest if field_class(c.outcome) == cls]
-        takes.append(rng.sample(pool, min(per_class, len(pool))))
-        counts[cls] = len(takes[-1])
-    # the classes interleaved (END, SF, ARR, END, ...): the cases run in this order, so the first N of a run
-    # stopped early (or of --limit N) are as stratified as N allows
-    chosen += [t[k] for k in range(max(map(len, takes), default=0)) for t in takes if k < len(t)]
-    return chosen, counts
+CASE_KEYS = ("id", "pit", "test", "observed", "predicted", "p_end", "p_sf", "p_arr", "static_class",
+             "static_peak_ratio", "recorded_cut", "runaway_cut", "slab_fracture_at", "slab_peak_stress_ratio",
+             *CASE_FEATURES, "w_f", "w_f_source", "setup", "particles", "steps", "threads", "workers", "wall_s",
+             "status", "error")
 
 
 def main(argv=None) -> int:

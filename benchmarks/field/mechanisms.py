@@ -1,0 +1,122 @@
+"""Which quantity of the column tells the observers' SF records from their END records, and how well?
+
+For every scored column of the development set's batches (``field_disagreements.json``, the runs' own readings)
+set up again from its pit, each candidate's value: the records' own numbers (slab depth, mean density), the
+run's (its slab's largest effective stress over strength), weac's static rule's (the slab's peak stress over
+strength at the recorded cut) and closed forms from published laws (``mpm_warp.field.mechanisms``: Heierli's
+touchdown distance against the column, the slab's brittleness). For each: the SF-against-END AUC (scikit-learn;
+the direction each candidate's physics says: a shorter touchdown distance, a larger stress ratio mean SF), the
+ARR-against-the-rest AUC, and the medians by observed class. A candidate's rule, where it has one (SF where the
+slab touches down inside the column), is scored as classes too. Nothing is fitted. Writes
+``benchmarks/field/results/field_mechanisms.json``.
+
+Usage: ``python benchmarks/field/mechanisms.py --data DIR`` (DIR: the unpacked pits); ``--quick``: 24 cases.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import sys
+import warnings
+
+from mpm_warp.field.batch import gather
+from mpm_warp.field.mechanisms import brittleness, touchdown_distance
+from mpm_warp.field.scores import scores
+from mpm_warp.field.static_rule import weac_static_rule
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+DISAGREEMENTS = os.path.join(RESULTS, "field_disagreements.json")
+
+#: candidate -> (what it is, +1: a larger value says SF; -1: a smaller one does)
+CANDIDATES = {
+    "slab_depth": ("the slab's bed-normal depth (m), recorded", -1),
+    "slab_density": ("the slab's mean density (kg/m^3), recorded or from hardness and grain", -1),
+    "run_slab_crack_ratio": ("the run's largest slab kappa over strength (-), 0 below strength", +1),
+    "static_peak_ratio": ("weac's slab peak stress over strength at the recorded cut (-)", +1),
+    "touchdown_distance": ("Heierli's touchdown distance of the slab (m)", -1),
+    "touchdown_over_column": ("the touchdown distance over the column's length (-)", -1),
+    "brittleness": ("slab depth over its characteristic length K_Ic^2 (1 - nu^2) / sigma_t^2 (-)", +1),
+}
+
+
+def case_key(row: dict) -> tuple[str, str]:
+    """(pit stem, field line) of a batch row: the pit's file is the id less its ``-<k>-<digest>`` tail."""
+    return row["id"].rsplit("-", 2)[0], row["test"]
+
+
+def describe(row: dict, case) -> dict:
+    """One column's candidates (:data:`CANDIDATES`)."""
+    p = case.params
+    td = touchdown_distance(p)
+    return {"id": row["id"], "observed": row["observed"], "predicted": row["predicted"],
+            "slab_depth": row["slab_depth_m"], "slab_density": row["slab_density"],
+            "run_slab_crack_ratio": row.get("slab_crack_ratio"),
+            "static_peak_ratio": weac_static_rule(p)["peak_ratio"], "touchdown_distance": td,
+            "touchdown_over_column": td / p.length, "brittleness": brittleness(p), "column_m": p.length}
+
+
+def auc(rows: list[dict], key: str, sign: int, positive: str, negatives: tuple[str, ...]) -> dict:
+    """AUC of ``sign * key`` for ``positive`` against ``negatives`` (None with one group empty)."""
+    from sklearn.metrics import roc_auc_score
+
+    use = [r for r in rows if r[key] is not None and r["observed"] in (positive, *negatives)]
+    y = [r["observed"] == positive for r in use]
+    return {"cases": len(use), "auc": float(roc_auc_score(y, [sign * r[key] for r in use]))
+            if 0 < sum(y) < len(y) else None}
+
+
+def table(rows: list[dict]) -> dict:
+    """Per candidate: its AUCs and medians by observed class."""
+    out = {}
+    for key, (what, sign) in CANDIDATES.items():
+        med = {c: statistics.median(v) if (v := [r[key] for r in rows if r["observed"] == c and r[key] is not None])
+               else None for c in ("END", "SF", "ARR")}
+        out[key] = {"what": what, "direction": "larger: SF" if sign > 0 else "smaller: SF",
+                    "sf_vs_end": auc(rows, key, sign, "SF", ("END",)),
+                    "arr_vs_rest": auc(rows, key, sign, "ARR", ("END", "SF")), "median": med}
+    return out
+
+
+def touchdown_rule(rows: list[dict]) -> dict:
+    """SF where the slab touches down inside its column (touchdown distance below the column's length), END
+    otherwise, scored as classes."""
+    obs = [r["observed"] for r in rows]
+    pred = ["SF" if r["touchdown_over_column"] < 1.0 else "END" for r in rows]
+    return {"rule": "SF where touchdown_over_column < 1, else END", **scores(obs, pred)}
+
+
+def main(argv=None) -> int:
+    p = parser(__doc__, "the first 24 cases")
+    p.add_argument("--data", required=True, help="folder of CAAML files the batches read")
+    p.add_argument("--cases", default=DISAGREEMENTS, help="the batches' scored cases (field_disagreements.json)")
+    args = p.parse_args(argv)
+    warnings.filterwarnings("ignore")
+    with open(args.cases) as fh:
+        src = json.load(fh)
+    rows = src["cases"][:24] if args.quick else src["cases"]
+    files = sorted({os.path.join(args.data, case_key(r)[0] + ".xml") for r in rows})
+    cases, _ = gather(files, calibrate=False)
+    by = {(os.path.splitext(c.pit)[0], c.test): c for c in cases}
+    missing = [r["id"] for r in rows if case_key(r) not in by]
+    if missing:
+        print(f"error: data: {len(missing)} scored cases have no record in their pit (e.g. {missing[0]})",
+              file=sys.stderr)
+        return 1
+    described = [describe(r, by[case_key(r)]) for r in rows]
+    data = {"name": "field_mechanisms", "cases_from": os.path.basename(args.cases),
+            "data": os.path.basename(os.path.normpath(args.data)), "environment": environment("cpu"),
+            "counts": {c: sum(r["observed"] == c for r in described) for c in ("END", "SF", "ARR")},
+            "candidates": table(described), "touchdown_rule": touchdown_rule(described), "cases": described}
+    path = write_json("field_mechanisms", data, out_dir(args, RESULTS, "field_mechanisms"))
+    for key, v in data["candidates"].items():
+        print(f"{key:24s} SF/END AUC {v['sf_vs_end']['auc']:.3f}  ARR/rest AUC {v['arr_vs_rest']['auc']:.3f}")
+    print(f"{path}: {len(described)} cases")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
