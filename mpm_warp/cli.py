@@ -81,12 +81,15 @@ def _summary(res, out=None):
         + (f"; {res.inversions} inversions (det F_tr <= 0) and {res.floor_events} singular-value floor events"
            if res.inversions or res.floor_events else "")
         + (f"\noutput: {res.output}" if res.output else "") + "\n")
+    from .field.probability import probability_line
+
     sr = dict(res.scene_result)
     oc, weac = sr.pop("outcome", None), sr.pop("weac", None)
     if oc is not None:
         where = (f", the slab broke {oc['slab_fracture_at']:.2f} m from the cut end" if oc["class"] == "SF" else
                  f", the crack stopped {oc['arrest_at']:.2f} m from the cut end" if oc["class"] == "ARR" else "")
         out.write(f"  field: {oc['field_line']}{where}" + (f" ({oc['note']})" if oc.get("note") else "") + "\n")
+        out.write(probability_line(oc))
     if weac is not None:
         if weac.get("weac") is None:
             out.write(f"  weac: {weac['note']}\n")

@@ -158,3 +158,31 @@ def test_score_records_drops_failed_runs_and_scores_every_forecast():
     sc = score_records(recs, resamples=200)
     assert "model" not in sc["forecast"] and "slab_peak_stress_ratio" in sc["forecast_missing"]["model"]
     assert sc["forecast_uncertainty"] is None
+
+
+@pytest.mark.parametrize("path", ["benchmarks/field/results/field_batch.json",
+                                  "benchmarks/field/results/measured/field_batch.json"])
+def test_the_committed_batches_rescore_to_their_committed_scores(path):
+    """Every score a committed batch wrote is what its committed cases give today (the class scores, their
+    intervals, the wall times); the forecasts it could not make say why."""
+    import json
+    import os
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    with open(os.path.join(root, path)) as fh:
+        data = json.load(fh)
+    again = json.loads(json.dumps(score_records(data["cases"], resamples=200)))
+    for key, value in data["scores"].items():
+        assert again[key] == value, key
+    assert again["cases"] == len([c for c in data["cases"] if c["status"] == "ok"])
+    assert set(again["forecast_missing"]) == {"model", "information_bar"}   # records from before both readings
+
+
+def test_the_run_summary_line_of_the_probabilities():
+    from mpm_warp.field.probability import probability_line
+
+    # F(0.5) = 1 - exp(-(0.5 Gamma(5/3))^1.5) = 0.262
+    line = probability_line({"class": "END", "slab_peak_stress_ratio": 0.5})
+    assert line.startswith("  P(END) 0.74, P(SF) 0.26, P(ARR) 0.00 (the slab's peak stress 0.50 x its strength")
+    assert probability_line({"class": None, "slab_peak_stress_ratio": 0.5}) == ""
+    assert probability_line({"class": "END"}) == ""                      # a slab that cannot break

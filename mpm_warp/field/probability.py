@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["WEIBULL_MODULUS", "weibull_break_probability", "outcome_probability"]
+__all__ = ["WEIBULL_MODULUS", "weibull_break_probability", "outcome_probability", "probability_line"]
 
 #: Weibull modulus of snow's tensile strength (-), Phys. Rev. E 69, 011306 (2004)
 WEIBULL_MODULUS = 1.5
@@ -40,3 +40,13 @@ def outcome_probability(predicted: str | None, slab_peak_stress_ratio: float | N
     if predicted in ("ARR", "NP"):
         return 0.0, p_sf, 1.0 - p_sf
     return 1.0 - p_sf, p_sf, 0.0
+
+
+def probability_line(outcome: dict) -> str:
+    """``  P(END) 0.63, P(SF) 0.37, P(ARR) 0.00 (...)`` and a newline for a PST run's ``outcome`` (its class and
+    ``slab_peak_stress_ratio``), or "" where it has no probability (a slab that cannot break, a run not decided)."""
+    p = outcome_probability(outcome.get("class"), outcome.get("slab_peak_stress_ratio"))
+    if p is None:
+        return ""
+    return (f"  P(END) {p[0]:.2f}, P(SF) {p[1]:.2f}, P(ARR) {p[2]:.2f} (the slab's peak stress "
+            f"{outcome['slab_peak_stress_ratio']:.2f} x its strength, under snow's Weibull strength scatter)\n")
