@@ -35,6 +35,7 @@ from . import (  # noqa: F401
     field,
     field_closure,
     field_far_end,
+    field_forecast,
     field_plane_stress,
     field_pre_cut,
     field_resolution,

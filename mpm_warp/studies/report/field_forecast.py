@@ -1,0 +1,100 @@
+"""Sections of the field outcome as a forecast: which mechanism carries the records' signal, and the probabilistic
+scores of the model against the climatology, the majority class, weac's rule and the information bar."""
+
+from __future__ import annotations
+
+from .core import section
+from .fmt import check_line, env_note, fx, table
+
+#: the forecasts in the order the tables list them
+NAMES = ("model", "information_bar", "weac_static", "majority", "climatology")
+
+
+def _iv(iv, nd: int = 2) -> str:
+    return "" if not iv else f" [{fx(iv[0], nd)}, {fx(iv[1], nd)}]"
+
+
+@section("field", "Why thin, light slabs break: each candidate mechanism against the records",
+         "field/results/field_mechanisms.json",
+         lambda d: "python benchmarks/field/mechanisms.py --data DIR",
+         question="The observers' SF slabs are thin and light. Which quantity of the column, from the records, the "
+                  "run, weac or a closed form of published laws, tells their SF records from their END records, and "
+                  "how well? Nothing is fitted.",
+         follows="The weak layer's stiffness: the same columns on a softer weak layer")
+def render_mechanisms(data: dict, ctx) -> list[str]:
+    c = data["candidates"]
+    rows = [[f"`{k}`", v["what"], v["direction"], fx(v["sf_vs_end"]["auc"], 3), fx(v["arr_vs_rest"]["auc"], 3),
+             " / ".join(fx(v["median"][k2], 3) for k2 in ("END", "SF", "ARR"))] for k, v in c.items()]
+    n = data["counts"]
+    out = [f"On the {sum(n.values())} scored columns of the development set's two batches (END {n['END']}, SF "
+           f"{n['SF']}, ARR {n['ARR']}; `{data['cases_from']}`), each set up again from its pit. AUC: the chance "
+           "that an SF record's value lies further in the candidate's direction than an END record's (0.5: no "
+           "skill; below 0.5: the signal runs the other way); ARR against the rest in the same direction.", ""]
+    out += table(["candidate", "what", "direction", "AUC SF vs END", "AUC ARR vs rest", "median END / SF / ARR"],
+                 rows)
+    best_record = max(c["slab_depth"]["sf_vs_end"]["auc"], c["slab_density"]["sf_vs_end"]["auc"])
+    td = c["touchdown_distance"]["sf_vs_end"]["auc"]
+    out += ["", check_line("a mechanism from published laws carries the records' SF signal",
+                           "its SF-against-END AUC at least that of slab depth or density alone, the records' "
+                           "own numbers", td >= best_record,
+                           f"Heierli's touchdown distance {fx(td, 3)}, against {fx(best_record, 3)}"), ""]
+    r = data["touchdown_rule"]
+    out += [f"- **The touchdown rule** ({r['rule']}: the slab lands on its collapsed weak layer inside the column): "
+            f"balanced accuracy {fx(r['balanced_accuracy'], 2)}, recall END {fx(r['recall']['END'], 2)}, SF "
+            f"{fx(r['recall']['SF'], 2)}, ARR {fx(r['recall']['ARR'], 2)} on these {r['n']} columns.",
+            f"- **The run's own slab** (`run_slab_crack_ratio`, its largest effective stress over strength) "
+            f"scores {fx(c['run_slab_crack_ratio']['sf_vs_end']['auc'], 3)}, and weac's static stress at the "
+            f"recorded cut {fx(c['static_peak_ratio']['sf_vs_end']['auc'], 3)}: neither tells the SF records from the "
+            "END records much better than chance; the touchdown distance, where the slab beyond the cut lands on "
+            "its collapsed weak layer, does.",
+            f"- **Brittleness** runs the other way ({fx(c['brittleness']['sf_vs_end']['auc'], 3)}): thin, light "
+            "slabs are the least brittle by this measure (the shortest depth for their characteristic length), so "
+            "brittleness does not explain why they break.", "", env_note(data)]
+    return out
+
+
+@section("field", "The outcome as a probability: forecast scores", "field/results/field_forecast.json",
+         lambda d: (f"python benchmarks/field/forecast.py DIR --runs RUNDIR --per-class "
+                    f"{d['selection'].get('per_class')} --seed {d['selection'].get('seed')}"),
+         figure="field/results/field_forecast.png",
+         question="Scored as forecasters score, does the model's probability of END, SF and ARR beat the set's "
+                  "climatology, weac's static rule and what the records alone carry?",
+         follows="Why thin, light slabs break: each candidate mechanism against the records")
+def render_forecast(data: dict, ctx) -> list[str]:
+    sc = data["scores"]
+    f, iv = sc["forecast"], (sc.get("forecast_uncertainty") or {}).get("intervals", {})
+    sel = data["selection"]
+    rows = []
+    for name in NAMES:
+        if name not in f:
+            continue
+        s, i = f[name], iv.get(name, {})
+        rows.append([name, fx(s["rps"], 3), fx(s["rpss"], 2) + _iv(i.get("rpss")),
+                     " / ".join(fx(s["brier"][k], 3) for k in ("END", "SF", "ARR")),
+                     fx(s["auc"]["SF"], 2) + _iv(i.get("auc_SF")), fx(s["auc"]["ARR"], 2) + _iv(i.get("auc_ARR")),
+                     fx(s["balanced_accuracy"], 2) + _iv(i.get("balanced_accuracy"))])
+    drawn = sum(sel.get(k, 0) for k in ("END", "SF", "ARR"))
+    out = [f"The first {sc['cases']} finished cases of the stratified draw ({drawn} drawn, {sel.get('per_class')} a "
+           f"class, seed {sel.get('seed')}), interleaved by class. The model: one run a case, read at first order "
+           "(its slab's peak stress under snow's Weibull strength scatter, docs/field.md). Intervals: 95 %, paired "
+           "bootstrap within each class.", ""]
+    out += table(["forecast", "RPS", "RPSS (vs climatology)", "Brier END / SF / ARR", "AUC SF", "AUC ARR",
+                  "balanced accuracy (most probable)"], rows)
+    for name, why in sc.get("forecast_missing", {}).items():
+        out += ["", f"- `{name}`: no forecast: {why}."]
+    m = f.get("model")
+    if m is not None:
+        weac = f.get("weac_static", {}).get("rpss")
+        bar = f.get("information_bar", {}).get("balanced_accuracy")
+        complete = sc["cases"] >= drawn
+        out += ["", check_line("the model's skill", "RPSS above the climatology's (0) and above weac's rule's",
+                               (m["rpss"] > 0.0 and (weac is None or m["rpss"] > weac)) if complete else None,
+                               f"{fx(m['rpss'], 2)} against weac's {fx(weac, 2)}"
+                               + ("" if complete else f"; {sc['cases']} of {drawn} drawn cases finished")),
+                check_line("the model's classes against the information bar",
+                           "balanced accuracy of its most probable class at least the bar's",
+                           (bar is None or m["balanced_accuracy"] >= bar) if complete else None,
+                           f"{fx(m['balanced_accuracy'], 2)} against {fx(bar, 2)}"
+                           + ("" if complete else "; the draw is not complete"))]
+    out += ["", env_note(data)]
+    return out
