@@ -43,7 +43,8 @@ def test_a_table_row_becomes_a_profile_or_one_line(tmp_path):
     assert [ly.thickness for ly in a.profile.layers] == [0.15, 0.04] and a.profile.slope_angle == 0.0
     assert b.profile.country == "US"                           # vertical ends, as the row asks
     assert bad.profile is None
-    assert bad.refusal == "psts.csv: row 4 (no-slope): slope_deg is empty (a number is required)"
+    assert bad.refusal == ("psts.csv: row 4 (no-slope): slope_deg is empty (required: a slope in [0, 60] deg (the "
+                           "model takes slopes of 0-60 deg))")
     (tmp_path / "broken.csv").write_text("id,outcome\nx,End\n")
     with pytest.raises(ValueError, match="columns slope_deg, column_cm, cut_cm, weak_layer_cm are missing"):
         table_profiles(tmp_path / "broken.csv")

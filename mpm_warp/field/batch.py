@@ -9,6 +9,10 @@ cluster or on a running scheduler, and writes to ``out_dir``::
     cases.csv            one row per case: observed against predicted, recorded cut against the runaway cut
     scores.json          confusion matrix, recall per class, balanced accuracy; the same for the baselines
     confusion.png        the confusion matrix
+    dask.log             Dask's own logs (unless verbose: then on the terminal)
+
+The inputs are set up lazily (:mod:`.batch_setup`): a batch with a ``limit`` sets up rows only until it has that
+many runnable cases, so a large table starts at once.
 
 A batch killed at any point resumes where it stopped: a case whose JSON says "ok" and whose run file reads
 back is not run again. A case that raises is recorded as failed with its error and never stops the others.
@@ -20,8 +24,10 @@ import contextlib
 import csv
 import glob
 import hashlib
+import itertools
 import json
 import os
+import re
 import statistics
 import sys
 import time
@@ -31,12 +37,12 @@ from dataclasses import dataclass
 
 from .. import io
 from ..errors import InvalidArgument
-from .cases import FieldCase, FieldRefusal, field_case, field_cases
+from .batch_setup import check_out_dir, check_scheduler, dask_log, iter_gather
+from .cases import FieldCase, FieldRefusal
 from .plain_words import in_field_terms
 from .protocol import FieldProtocol, decided, protocol_params
 from .scores import baseline_majority, field_class, scores
 from .static_rule import weac_static_class
-from .table import table_profiles
 from .uncertainty import balanced_accuracy_intervals
 
 __all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "run_records", "case_digest",
@@ -54,30 +60,16 @@ class FieldBatch:
     out_dir: str
 
 
-def gather(inputs, calibrate: bool = True) -> tuple[list[FieldCase], list[FieldRefusal]]:
-    """The cases and refusals of every input: a folder of CAAML files (``*.xml``, ``*.caaml``), one CAAML file,
-    or a CSV table of PSTs (:mod:`.table`). ``calibrate=False`` leaves the weak layer's calibration to the run
-    (a selection from many records then calibrates only what it runs)."""
+def gather(inputs, calibrate: bool = True, limit: int | None = None) -> tuple[list[FieldCase], list[FieldRefusal]]:
+    """The cases and refusals of every input: a folder of CAAML files (``*.xml``, ``*.caaml``, any case), one
+    CAAML file, or a CSV table of PSTs (:mod:`.table`). ``calibrate=False`` leaves the weak layer's calibration to
+    the run (a selection from many records then calibrates only what it runs). With ``limit``, the inputs are set
+    up only until ``limit`` cases are found (the refusals met on the way are kept)."""
     cases, refused = [], []
-    for path in inputs:
-        path = os.fspath(path)
-        if os.path.isdir(path):
-            files = sorted(glob.glob(os.path.join(path, "*.xml")) + glob.glob(os.path.join(path, "*.caaml")))
-        elif path.lower().endswith(".csv"):
-            for row in table_profiles(path):
-                if row.refusal is not None:
-                    refused.append(FieldRefusal(os.path.basename(path), row.id, "table row", row.refusal))
-                    continue
-                r = field_case(row.profile, row.record, w_f=row.w_f, calibrate=calibrate)
-                (cases if isinstance(r, FieldCase) else refused).append(r)
-            continue
-        elif os.path.isfile(path):
-            files = [path]
-        else:
-            raise InvalidArgument("INPUT", path, "a folder of CAAML files, a CAAML file or a CSV table of PSTs")
-        for f in files:
-            for r in field_cases(f, calibrate=calibrate):
-                (cases if isinstance(r, FieldCase) else refused).append(r)
+    for r in iter_gather(inputs, calibrate=calibrate):
+        (cases if isinstance(r, FieldCase) else refused).append(r)
+        if limit is not None and len(cases) >= limit:
+            break
     return cases, refused
 
 
@@ -88,9 +80,15 @@ def case_digest(case: FieldCase, proto: FieldProtocol) -> str:
     return hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
+#: what a case's file name may not hold (a separator above all)
+_UNSAFE = re.compile(r"[^\w.-]")
+
+
 def _case_id(case: FieldCase, k: int, proto: FieldProtocol) -> str:
+    """The case's file name in ``--out``: its pit's name (any character but letters, digits, ``.``, ``_`` and
+    ``-`` replaced, so that an id ``a/b`` or ``../..`` stays a file inside the folder), its position, its key."""
     stem = os.path.splitext(case.pit)[0].replace("#", "-").replace(" ", "_")
-    return f"{stem}-{k}-{case_digest(case, proto)}"
+    return f"{_UNSAFE.sub('_', stem)}-{k}-{case_digest(case, proto)}"
 
 
 def _write_json(path: str, obj: dict) -> None:
@@ -136,6 +134,8 @@ def run_case(task: dict) -> dict:
 
 
 def _finished(task: dict) -> dict | None:
+    """The task's record from an earlier batch when it finished; None (run it again) where its file says otherwise,
+    whatever it holds (``[]``, a truncated file)."""
     return io.finished_record(os.path.join(task["out_dir"], task["id"]))
 
 
@@ -156,7 +156,7 @@ def run_records(run_dirs) -> list[tuple[dict, str]]:
         for path in sorted(glob.glob(os.path.join(run_dir, "*.json"))):
             with open(path) as fh:
                 r = json.load(fh)
-            if r.get("status") == "ok" and "predicted" in r:
+            if isinstance(r, dict) and r.get("status") == "ok" and "predicted" in r:
                 out.append((r, run_dir))
     return out
 
@@ -183,38 +183,50 @@ def case_scenario(case: FieldCase, proto: FieldProtocol):
     return (None, note) if params is None else (build(params, tc, name="field"), note)
 
 
+def _task(c: FieldCase, k: int, out_dir, proto, device, refused) -> dict | None:
+    """The task of the ``k``-th case ``c``, or None with its refusal added to ``refused``."""
+    try:
+        scenario, note = case_scenario(c, proto)
+        if scenario is None:
+            refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
+            return None
+        params = scenario.scene
+    except InvalidArgument as e:
+        refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, c.params), c.outcome))
+        return None
+    wf = c.fracture_energy
+    return {"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
+            "recorded_cut": c.record.cut_length, "static_class": weac_static_class(c.params),
+            "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
+            "setup": note, "scenario": scenario, "out_dir": out_dir, "device": device, "threads": proto.threads}
+
+
 def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
-    tasks = []
-    for k, c in enumerate(cases):
-        try:
-            scenario, note = case_scenario(c, proto)
-            if scenario is None:
-                refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
-                continue
-            params = scenario.scene
-        except InvalidArgument as e:
-            refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, c.params), c.outcome))
-            continue
-        wf = c.fracture_energy
-        tasks.append({"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
-                      "recorded_cut": c.record.cut_length, "static_class": weac_static_class(c.params),
-                      "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
-                      "setup": note, "scenario": scenario, "out_dir": out_dir,
-                      "device": device, "threads": proto.threads})
-    return tasks
+    tasks = (_task(c, k, out_dir, proto, device, refused) for k, c in enumerate(cases))
+    return [t for t in tasks if t is not None]
 
 
-def _execute(todo, records, workers, scheduler, stream, total, threads=1) -> None:
-    from distributed import Client, LocalCluster, as_completed
+def _client(stack, scheduler, workers, threads, verbose):
+    from distributed import Client, LocalCluster
+
+    if not scheduler:
+        cluster = stack.enter_context(LocalCluster(
+            n_workers=workers or max(1, (os.cpu_count() or 1) // threads), threads_per_worker=1, processes=True,
+            dashboard_address=None, silence_logs=False if verbose else 40, env={"MPM_WARP_THREADS": str(threads)}))
+        return stack.enter_context(Client(cluster))
+    try:
+        return stack.enter_context(Client(scheduler, timeout=30))
+    except (OSError, ValueError, TimeoutError) as e:
+        raise InvalidArgument("scheduler", scheduler, f"the address of a running Dask scheduler ({e})") from None
+
+
+def _execute(todo, records, workers, scheduler, stream, total, threads=1, out_dir=".", verbose=False) -> None:
+    from distributed import as_completed
 
     with contextlib.ExitStack() as stack:
-        if scheduler:
-            client = stack.enter_context(Client(scheduler))
-        else:
-            cluster = stack.enter_context(LocalCluster(
-                n_workers=workers or max(1, (os.cpu_count() or 1) // threads), threads_per_worker=1, processes=True,
-                dashboard_address=None, silence_logs=40, env={"MPM_WARP_THREADS": str(threads)}))
-            client = stack.enter_context(Client(cluster))
+        terminal = stack.enter_context(dask_log(out_dir, verbose))
+        stream = terminal if stream is True else stream
+        client = _client(stack, scheduler, workers, threads, verbose)
         n_workers = len(client.scheduler_info().get("workers", {})) or None
         todo = [{**t, "workers": n_workers} for t in todo]    # each record says how many cases ran beside it
         token, t0, done = uuid.uuid4().hex[:8], time.perf_counter(), 0
@@ -241,7 +253,7 @@ def _execute(todo, records, workers, scheduler, stream, total, threads=1) -> Non
 
 def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
               device: str | None = "cpu", protocol: FieldProtocol | None = None, limit: int | None = None,
-              progress=True) -> FieldBatch:
+              progress=True, verbose: bool = False) -> FieldBatch:
     """Set up, run and score every PST record of ``inputs`` (module docstring).
 
     Parameters
@@ -260,32 +272,74 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
     protocol : FieldProtocol, optional
         The per-case budget and the saw (default :class:`~.protocol.FieldProtocol`).
     limit : int, optional
-        Run only the first ``limit`` runnable cases (in input order).
+        Run only the first ``limit`` runnable cases (in input order): the inputs are set up only until that many
+        are found, and a refused record does not count.
     progress : bool or text stream
         One progress line on stderr (True), on the given stream, or none.
+    verbose : bool
+        Dask's logs on the terminal; else in ``dask.log`` in ``out_dir``.
     """
     if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
         raise InvalidArgument("limit", limit, "an integer >= 1")
-    cases, refused = gather(inputs)
-    return run_cases(cases[:limit] if limit is not None else cases, refused, out_dir, workers=workers,
-                     scheduler=scheduler, device=device, protocol=protocol, progress=progress)
+    proto = _checked(workers, scheduler, protocol, out_dir)
+    stream = _stream(progress)
+    items, cases, refused, tasks = iter_gather(inputs), [], [], []
+    t0 = shown = time.perf_counter()
+    for n in itertools.count(1):
+        if limit is not None and len(tasks) >= limit:
+            break
+        item = next(items, None)
+        if item is None:
+            break
+        if isinstance(item, FieldCase):
+            cases.append(item)
+            task = _task(item, len(cases) - 1, out_dir, proto, device, refused)
+            tasks += [task] if task is not None else []
+        else:
+            refused.append(item)
+        if stream is not None and (n == 1 or time.perf_counter() - shown > 0.5):
+            shown = time.perf_counter()
+            stream.write(f"\rfield: set up {n} records: {len(tasks)} to run, {len(refused)} refused "
+                         f"({shown - t0:.0f} s) ")
+            stream.flush()
+    if stream is not None and (cases or refused):
+        stream.write(f"\rfield: set up {len(cases) + len(refused)} records: {len(tasks)} to run, {len(refused)} "
+                     f"refused ({time.perf_counter() - t0:.0f} s)\n")
+    return _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress, verbose)
 
 
-def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
-              device: str | None = "cpu", protocol: FieldProtocol | None = None, progress=True) -> FieldBatch:
-    """Run the field cases ``cases`` (:func:`gather`'s, or a selection of them) and score them, as :func:`run_field`;
-    ``refused`` (their refusals) goes to ``refused.csv``."""
+def _checked(workers, scheduler, protocol, out_dir) -> FieldProtocol:
+    """The batch's protocol, once its arguments and its folder are checked (before anything is set up)."""
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise InvalidArgument("workers", workers, "an integer >= 1")
     proto = (protocol or FieldProtocol()).validate()
+    check_scheduler(scheduler)
+    check_out_dir(out_dir)
+    return proto
+
+
+def _stream(progress):
+    return sys.stderr if progress is True else (progress or None)
+
+
+def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
+              device: str | None = "cpu", protocol: FieldProtocol | None = None, progress=True,
+              verbose: bool = False) -> FieldBatch:
+    """Run the field cases ``cases`` (:func:`gather`'s, or a selection of them) and score them, as :func:`run_field`;
+    ``refused`` (their refusals) goes to ``refused.csv``."""
+    proto = _checked(workers, scheduler, protocol, out_dir)
     refused = list(refused)
-    os.makedirs(out_dir, exist_ok=True)
     tasks = _tasks(cases, out_dir, proto, device, refused)
+    return _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress, verbose)
+
+
+def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress, verbose) -> FieldBatch:
+    """Run the tasks not finished in ``out_dir`` before, write the records, the refusals and the scores."""
     records = {t["id"]: _finished(t) for t in tasks}
     todo = [t for t in tasks if records[t["id"]] is None]
-    stream = sys.stderr if progress is True else (progress or None)
     if todo:
-        _execute(todo, records, workers, scheduler, stream, len(tasks), proto.threads)
+        _execute(todo, records, workers, scheduler, progress if progress is True else _stream(progress), len(tasks),
+                 proto.threads, out_dir, verbose)
     recs = [records[t["id"]] for t in tasks]
     _write_outputs(out_dir, recs, refused)
     sc = score_records(recs)
@@ -303,11 +357,11 @@ CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "static_
 
 
 def _write_outputs(out_dir: str, recs: list, refused: list) -> None:
-    with open(os.path.join(out_dir, "cases.csv"), "w", newline="") as fh:
+    with open(os.path.join(out_dir, "cases.csv"), "w", newline="", encoding="utf-8") as fh:
         w = csv.DictWriter(fh, CASE_COLUMNS, extrasaction="ignore")
         w.writeheader()
         w.writerows(recs)
-    with open(os.path.join(out_dir, "refused.csv"), "w", newline="") as fh:
+    with open(os.path.join(out_dir, "refused.csv"), "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(["pit", "test", "outcome", "reason", "message"])
         w.writerows([r.pit, r.test, r.outcome or "", r.reason, r.message] for r in refused)
