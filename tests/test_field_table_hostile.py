@@ -250,3 +250,13 @@ def test_a_table_that_cannot_be_read_is_a_table_error(tmp_path):
     path.write_text(table(header=(*HEADER, "whatever"), whatever="x"))
     with pytest.raises(TableError, match="unknown column 'whatever': the columns are id, outcome"):
         table_profiles(path)
+
+
+def test_the_documented_ranges_are_the_readers():
+    """docs/field.md's table of columns gives every range the reader checks, as the reader writes it."""
+    with open(os.path.join(os.path.dirname(PITS), "..", "..", "docs", "field.md"), encoding="utf-8") as fh:
+        rows = [ln for ln in fh.read().splitlines() if ln.startswith("| `")]
+    for key, rng in RANGES.items():
+        col = "layers" if key in ("thickness_cm", "density") else key
+        (line,) = [ln for ln in rows if f"`{col}`" in ln.split("|")[1]]
+        assert f"{'(' if rng.open_lo else '['}{rng.lo:g}, {rng.hi:g}] {rng.unit}" in line, (key, line)
