@@ -110,6 +110,11 @@ CASES = [
      ["weak_layer_cm = -3 cm", "column_cm = -60 cm", "cut_cm = -5 cm"], []),
     ("a-decimal-comma-in-a-comma-table", {"t.csv": table(header=HEADER[:-1], w_f="0,3")}, [], 0,
      ["refused t.csv#p1: row 2: 1 value(s) beyond the 10 columns (3): a decimal comma", "w_f = 0 J/m^2"], []),
+    ("quoted-decimal-comma-in-a-comma-table", {"t.csv": table(w_f='"0,3"')}, [], 0,
+     ["refused t.csv#p1: row 2: w_f = '0,3' is not a number (a decimal comma? use a point"], []),
+    ("not-a-number", {"t.csv": table(slope_deg="nan", slab_cm="40 cm")}, [], 0,
+     ["refused t.csv#p1: row 2: slab_cm = '40 cm' is not a number: expected a thickness in (0, 500] cm",
+      "slope_deg = 'nan' is not a number"], []),
     ("out-unwritable", {"t.csv": table()}, ["--out", "t.csv/out"], 2,
      ["out = ", "is invalid: expected a folder this user can create and write in"], []),
 ]
