@@ -44,7 +44,8 @@ def iter_gather(inputs, calibrate: bool = True):
     for path in inputs:
         path = os.fspath(path)
         if os.path.isdir(path):
-            files = sorted(os.path.join(path, f) for f in os.listdir(path) if f.lower().endswith(CAAML_SUFFIXES))
+            files = sorted(os.path.join(path, f) for f in os.listdir(path)
+                           if f.lower().endswith(CAAML_SUFFIXES) and not f.startswith("."))   # as a glob "*" lists
             sources.append(("caaml", files))
         elif path.lower().endswith(".csv") and os.path.isfile(path):
             sources.append(("table", (os.path.basename(path), iter_table(path))))
