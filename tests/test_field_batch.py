@@ -70,6 +70,7 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     assert again.skipped == 1 and len(again.records) == 2 and os.stat(done).st_mtime_ns == stamp
     assert all(r["status"] == "ok" for r in again.records)
     assert [r["observed"] for r in again.records] == ["END", "ARR"]
+    assert [r["w_f_source"] for r in again.records] == ["given", "given"]     # the table's w_f, not read back
     assert all(r["predicted"] in ("END", "SF", "ARR", "NP", "running") for r in again.records)
     # the files a reader gets: the cases, the refusals, the scores of the model and its baselines, the figure
     with open(os.path.join(out, "scores.json")) as fh:

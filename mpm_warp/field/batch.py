@@ -195,9 +195,10 @@ def _task(c: FieldCase, k: int, out_dir, proto, device, refused) -> dict | None:
         refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, c.params), c.outcome))
         return None
     wf = c.fracture_energy
+    source = "given" if wf.reason == "given" else ("read back" if wf.value is not None else wf.reason)
     return {"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
             "recorded_cut": c.record.cut_length, "static_class": weac_static_class(c.params),
-            "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
+            "w_f": params.weak_layer.w_f, "w_f_source": source,
             "setup": note, "scenario": scenario, "out_dir": out_dir, "device": device, "threads": proto.threads}
 
 
