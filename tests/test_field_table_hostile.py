@@ -220,19 +220,27 @@ def test_limit_counts_runnable_rows_and_sets_up_no_more(tmp_path, monkeypatch):
     assert refused[0].message.startswith("slope_deg = 70 deg is outside the range: expected a slope in [0, 60] deg")
 
 
-def test_a_100000_row_table_starts_its_first_case_at_once(tmp_path, monkeypatch):
-    """--limit 1 on 100,000 rows sets up one row and hands one task to Dask, well within 10 s."""
+@pytest.mark.parametrize("limit", [1, None])
+def test_a_100000_row_table_starts_its_first_case_at_once(tmp_path, monkeypatch, limit):
+    """On 100,000 rows, with --limit 1 or without, the first case goes to Dask once its own row is set up: one
+    setup, well within 10 s (the rows after it are set up while it runs)."""
     from mpm_warp.field import batch
 
     path = tmp_path / "big.csv"
     path.write_text(",".join(HEADER) + "\n" + "\n".join([RUNS] * 100_000) + "\n")
     calls, handed = _counted(monkeypatch), []
-    monkeypatch.setattr(batch, "_run_tasks", lambda tasks, refused, *a: handed.append((tasks, refused)))
+
+    def first_only(todo, records, *a):      # as _execute takes its first task, without a cluster
+        t = next(todo)
+        handed.append((time.perf_counter() - t0, len(calls), t))
+        records[t["id"]] = {"id": t["id"], "status": "failed", "error": "not run here"}
+
+    monkeypatch.setattr(batch, "_execute", first_only)
     t0 = time.perf_counter()
-    run_field([str(path)], str(tmp_path / "run"), limit=1, progress=False)
-    assert time.perf_counter() - t0 < 10.0
-    ((tasks, refused),) = handed
-    assert len(calls) == 1 and len(tasks) == 1 and refused == [] and tasks[0]["pit"] == "big.csv#tiny-a"
+    res = run_field([str(path)], str(tmp_path / "run"), limit=limit, progress=False)
+    ((elapsed, setups, task),) = handed
+    assert elapsed < 10.0 and setups == 1 and task["pit"] == "big.csv#tiny-a" and task["id"].startswith("big-0-")
+    assert [r["id"] for r in res.records] == [task["id"]] and res.refused == []
 
 
 def test_dask_logs_go_to_a_file_unless_verbose(tmp_path, capfd):

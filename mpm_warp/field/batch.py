@@ -11,8 +11,8 @@ cluster or on a running scheduler, and writes to ``out_dir``::
     confusion.png        the confusion matrix
     dask.log             Dask's own logs (unless verbose: then on the terminal)
 
-The inputs are set up lazily (:mod:`.batch_setup`): a batch with a ``limit`` sets up rows only until it has that
-many runnable cases, so a large table starts at once.
+The inputs are set up lazily (:mod:`.batch_setup`) and each runnable case is submitted once set up, so a large
+table's first case starts at once; a batch with a ``limit`` sets up rows only until it has that many.
 
 A batch killed at any point resumes where it stopped: a case whose JSON says "ok" and whose run file reads
 back is not run again. A case that raises is recorded as failed with its error and never stops the others.
@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 from .. import io
 from ..errors import InvalidArgument
-from .batch_setup import check_out_dir, check_scheduler, dask_log, iter_gather
+from .batch_setup import Progress, check_out_dir, check_scheduler, dask_client, dask_log, iter_gather
 from .cases import FieldCase, FieldRefusal
 from .plain_words import in_field_terms
 from .protocol import FieldProtocol, decided, protocol_params
@@ -207,34 +207,24 @@ def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
     return [t for t in tasks if t is not None]
 
 
-def _client(stack, scheduler, workers, threads, verbose):
-    from distributed import Client, LocalCluster
-
-    if not scheduler:
-        cluster = stack.enter_context(LocalCluster(
-            n_workers=workers or max(1, (os.cpu_count() or 1) // threads), threads_per_worker=1, processes=True,
-            dashboard_address=None, silence_logs=False if verbose else 40, env={"MPM_WARP_THREADS": str(threads)}))
-        return stack.enter_context(Client(cluster))
-    try:
-        return stack.enter_context(Client(scheduler, timeout=30))
-    except (OSError, ValueError, TimeoutError) as e:
-        raise InvalidArgument("scheduler", scheduler, f"the address of a running Dask scheduler ({e})") from None
-
-
-def _execute(todo, records, workers, scheduler, stream, total, threads=1, out_dir=".", verbose=False) -> None:
+def _execute(todo, records, workers, scheduler, progress: Progress, threads=1, out_dir=".", verbose=False) -> None:
+    """Run the tasks of the iterator ``todo`` as they come (each submitted once set up, so the first case starts
+    while the later rows are set up) and put their records in ``records``; no cluster where there is none."""
     from distributed import as_completed
 
+    first = next(todo, None)
+    if first is None:
+        return
     with contextlib.ExitStack() as stack:
         terminal = stack.enter_context(dask_log(out_dir, verbose))
-        stream = terminal if stream is True else stream
-        client = _client(stack, scheduler, workers, threads, verbose)
+        if progress.stream is sys.stderr:
+            progress.stream = terminal
+        client = dask_client(stack, scheduler, workers, threads, verbose)
         n_workers = len(client.scheduler_info().get("workers", {})) or None
-        todo = [{**t, "workers": n_workers} for t in todo]    # each record says how many cases ran beside it
-        token, t0, done = uuid.uuid4().hex[:8], time.perf_counter(), 0
-        futures = {client.submit(run_case, t, key=f"{t['id']}-{token}", retries=1, pure=False, priority=-i): t
-                   for i, t in enumerate(todo)}
-        for fut in as_completed(list(futures)):
-            task = futures[fut]
+        token, futures, running = uuid.uuid4().hex[:8], {}, as_completed()
+
+        def collect(fut):
+            task = futures.pop(fut)
             try:
                 rec = fut.result()
             except Exception as e:   # the worker died too often, or the cluster is gone
@@ -242,14 +232,20 @@ def _execute(todo, records, workers, scheduler, stream, total, threads=1, out_di
                 _write_json(os.path.join(task["out_dir"], task["id"] + ".json"), rec)
             fut.release()
             records[task["id"]] = rec
-            done += 1
-            if stream is not None:
-                el = time.perf_counter() - t0
-                stream.write(f"\rfield: {total - len(todo) + done}/{total} cases, elapsed {el:.0f} s, "
-                             f"ETA {el / done * (len(todo) - done):.0f} s ")
-                stream.flush()
-        if stream is not None:
-            stream.write("\n")
+            progress.done += 1
+            progress.show()
+
+        for i, t in enumerate(itertools.chain([first], todo)):
+            t = {**t, "workers": n_workers}    # each record says how many cases ran beside it
+            fut = client.submit(run_case, t, key=f"{t['id']}-{token}", retries=1, pure=False, priority=-i)
+            futures[fut] = t
+            running.add(fut)
+            while running.has_ready():
+                collect(next(running))
+        progress.setting_up = False
+        for fut in running:
+            collect(fut)
+        progress.stream = sys.stderr if progress.stream is terminal else progress.stream
 
 
 def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
@@ -283,30 +279,26 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
     if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
         raise InvalidArgument("limit", limit, "an integer >= 1")
     proto = _checked(workers, scheduler, protocol, out_dir)
-    stream = _stream(progress)
-    items, cases, refused, tasks = iter_gather(inputs), [], [], []
-    t0 = shown = time.perf_counter()
-    for n in itertools.count(1):
-        if limit is not None and len(tasks) >= limit:
-            break
-        item = next(items, None)
-        if item is None:
-            break
-        if isinstance(item, FieldCase):
-            cases.append(item)
-            task = _task(item, len(cases) - 1, out_dir, proto, device, refused)
-            tasks += [task] if task is not None else []
-        else:
-            refused.append(item)
-        if stream is not None and (n == 1 or time.perf_counter() - shown > 0.5):
-            shown = time.perf_counter()
-            stream.write(f"\rfield: set up {n} records: {len(tasks)} to run, {len(refused)} refused "
-                         f"({shown - t0:.0f} s) ")
-            stream.flush()
-    if stream is not None and (cases or refused):
-        stream.write(f"\rfield: set up {len(cases) + len(refused)} records: {len(tasks)} to run, {len(refused)} "
-                     f"refused ({time.perf_counter() - t0:.0f} s)\n")
-    return _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress, verbose)
+    items, refused, shown = iter_gather(inputs), [], Progress(_stream(progress))
+
+    def setup():
+        cases = runnable = 0
+        for item in items:
+            shown.records += 1
+            if isinstance(item, FieldCase):
+                task = _task(item, cases, out_dir, proto, device, refused)
+                cases += 1
+                if task is not None:
+                    yield task
+                    runnable += 1
+                    if limit is not None and runnable >= limit:
+                        return
+            else:
+                refused.append(item)
+            shown.refused = len(refused)
+            shown.show()
+
+    return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose)
 
 
 def _checked(workers, scheduler, protocol, out_dir) -> FieldProtocol:
@@ -329,26 +321,47 @@ def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None =
     """Run the field cases ``cases`` (:func:`gather`'s, or a selection of them) and score them, as :func:`run_field`;
     ``refused`` (their refusals) goes to ``refused.csv``."""
     proto = _checked(workers, scheduler, protocol, out_dir)
-    refused = list(refused)
-    tasks = _tasks(cases, out_dir, proto, device, refused)
-    return _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress, verbose)
+    refused, shown = list(refused), Progress(_stream(progress))
+
+    def setup():
+        for k, c in enumerate(cases):
+            shown.records += 1
+            task = _task(c, k, out_dir, proto, device, refused)
+            if task is not None:
+                yield task
+
+    return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose)
 
 
-def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress, verbose) -> FieldBatch:
-    """Run the tasks not finished in ``out_dir`` before, write the records, the refusals and the scores."""
-    records = {t["id"]: _finished(t) for t in tasks}
-    todo = [t for t in tasks if records[t["id"]] is None]
-    if todo:
-        _execute(todo, records, workers, scheduler, progress if progress is True else _stream(progress), len(tasks),
-                 proto.threads, out_dir, verbose)
-    recs = [records[t["id"]] for t in tasks]
+def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Progress, verbose) -> FieldBatch:
+    """Run the tasks of the iterator ``tasks`` not finished in ``out_dir`` before, as they are set up; write the
+    records, the refusals and the scores."""
+    done, ran, records = [], [], {}
+
+    def todo():
+        for t in tasks:
+            done.append(t)
+            progress.tasks = len(done)
+            progress.refused = len(refused)
+            records[t["id"]] = _finished(t)
+            if records[t["id"]] is None:
+                ran.append(t)
+                yield t
+            else:
+                progress.done += 1
+            progress.show()
+
+    _execute(todo(), records, workers, scheduler, progress, proto.threads, out_dir, verbose)
+    progress.refused = len(refused)
+    progress.end()
+    recs = [records[t["id"]] for t in done]
     _write_outputs(out_dir, recs, refused)
     sc = score_records(recs)
     _write_json(os.path.join(out_dir, "scores.json"), sc)
     from .figures import plot_confusion
 
     plot_confusion(sc, os.path.join(out_dir, "confusion.png"))
-    return FieldBatch(recs, refused, sc, len(tasks) - len(todo), out_dir)
+    return FieldBatch(recs, refused, sc, len(done) - len(ran), out_dir)
 
 
 #: the columns of cases.csv

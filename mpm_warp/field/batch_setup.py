@@ -1,10 +1,12 @@
-"""What a field batch checks and opens before it runs: its inputs (read lazily), its folder, its scheduler, its logs.
+"""What a field batch checks and opens around its runs: its inputs (read lazily), its folder, its scheduler, its
+logs, its Dask client and its progress line.
 
 :func:`iter_gather` yields the cases and refusals of the inputs one at a time, so a batch with ``--limit`` sets up
 only the rows it runs and a large table starts at once; every input is checked first (a table that cannot be read
 at all is one :class:`~.table_read.TableError` line before anything is set up). :func:`check_out_dir` and
 :func:`check_scheduler` refuse an unwritable ``--out`` or a scheduler address that is not one, in one line.
-:func:`dask_log` sends Dask's own logs (the local cluster's workers included) to ``dask.log`` in ``--out``.
+:func:`dask_log` sends Dask's own logs (the local cluster's workers included) to ``dask.log`` in ``--out``;
+:func:`dask_client` opens the cluster; :class:`Progress` is the batch's one line on the terminal.
 """
 
 from __future__ import annotations
@@ -12,12 +14,14 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import time
 
 from ..errors import InvalidArgument
 from .cases import FieldRefusal, field_case, field_cases
 from .table import iter_table
 
-__all__ = ["iter_gather", "check_out_dir", "check_scheduler", "dask_log", "CAAML_SUFFIXES", "DASK_LOG"]
+__all__ = ["iter_gather", "check_out_dir", "check_scheduler", "dask_log", "dask_client", "Progress", "CAAML_SUFFIXES",
+           "DASK_LOG"]
 
 #: the file names a folder's CAAML pits end with (any case: ``.XML`` as some exports write it)
 CAAML_SUFFIXES = (".xml", ".caaml")
@@ -125,3 +129,49 @@ def dask_log(out_dir: str, verbose: bool):
     finally:
         os.dup2(saved, 2)
         os.close(saved)
+
+
+def dask_client(stack, scheduler, workers, threads, verbose):
+    """A client of the running scheduler ``scheduler``, else of a local cluster of ``workers`` processes (default:
+    the cores over ``threads``), entered on the exit stack ``stack``; a scheduler that cannot be reached is one
+    :class:`~mpm_warp.errors.InvalidArgument` line."""
+    from distributed import Client, LocalCluster
+
+    if not scheduler:
+        cluster = stack.enter_context(LocalCluster(
+            n_workers=workers or max(1, (os.cpu_count() or 1) // threads), threads_per_worker=1, processes=True,
+            dashboard_address=None, silence_logs=False if verbose else 40, env={"MPM_WARP_THREADS": str(threads)}))
+        return stack.enter_context(Client(cluster))
+    try:
+        return stack.enter_context(Client(scheduler, timeout=30))
+    except (OSError, ValueError, TimeoutError) as e:
+        raise InvalidArgument("scheduler", scheduler, f"the address of a running Dask scheduler ({e})") from None
+
+
+class Progress:
+    """The batch's one progress line: the records set up (and refused), the cases done of those to run so far."""
+
+    def __init__(self, stream):
+        self.stream, self.t0, self.shown = stream, time.perf_counter(), -1.0
+        self.records = self.refused = self.tasks = self.done = 0
+        self.setting_up = True
+
+    def show(self, force: bool = False) -> None:
+        """Write the line (at most twice a second unless ``force``)."""
+        now = time.perf_counter()
+        if self.stream is None or (not force and now - self.shown < 0.5):
+            return
+        self.shown, el = now, now - self.t0
+        more = "+" if self.setting_up else ""
+        eta = (f", ETA {el / self.done * (self.tasks - self.done):.0f} s" if self.done and not self.setting_up
+               else "")
+        self.stream.write(f"\rfield: {self.records}{more} records set up ({self.refused} refused), "
+                          f"{self.done}/{self.tasks}{more} cases done, elapsed {el:.0f} s{eta} ")
+        self.stream.flush()
+
+    def end(self) -> None:
+        """The last line, and a new line."""
+        if self.stream is not None and (self.records or self.tasks):
+            self.setting_up = False
+            self.show(force=True)
+            self.stream.write("\n")
