@@ -10,9 +10,11 @@ DESCRIPTION = (
     "Run every PST record of real snow pits as the field runs it (the saw stops once the crack runs away) and "
     "measure the predicted outcome (END, SF, ARR) against what the observer wrote. INPUT: folders of CAAML "
     "files, CAAML files, or CSV tables of PSTs (columns: id, outcome, slope_deg, column_cm, cut_cm, slab_cm and "
-    "slab_density or layers, weak_layer_cm, optional weak_layer_density, w_f, column_ends; docs/profiles.md). "
+    "slab_density or layers, weak_layer_cm, optional weak_layer_density, w_f, column_ends; docs/field.md). "
     "Each case is a Dask task on a local cluster (--workers) or an existing one (--scheduler); a killed batch "
-    "resumes where it stopped. Writes the runs, cases.csv, refused.csv, scores.json and confusion.png to --out.")
+    "resumes where it stopped. Writes the runs, cases.csv, refused.csv, scores.json and confusion.png to --out; "
+    "every refused record is also one line on the terminal, and Dask's logs go to dask.log there (--verbose: to the "
+    "terminal).")
 EXAMPLE = "example: mpm-warp field pits/ --out field-run --workers 2"
 
 
@@ -25,8 +27,10 @@ def cmd_field(a) -> int:
                     protocol=FieldProtocol(max_particles=a.max_particles, threads=a.threads,
                                            rigid_base=not a.elastic_substratum, pre_cut_share=a.pre_cut_share,
                                            interface_closure=a.interface_closure),
-                    progress=not a.quiet)
+                    progress=not a.quiet, verbose=a.verbose)
     sc = res.scores
+    for r in res.refused:
+        print(f"refused {r.line()}", file=sys.stderr)
 
     def ba(k):
         v = sc[k]["balanced_accuracy"]
@@ -64,4 +68,5 @@ def add_field(sub) -> None:
     p.add_argument("--interface-closure", action="store_true",
                    help="run each column with the laminate closure at its layer interfaces (docs/model.md §5b)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.add_argument("--verbose", action="store_true", help="Dask's logs on the terminal (default: dask.log in --out)")
     p.set_defaults(func=cmd_field)

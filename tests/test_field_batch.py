@@ -43,7 +43,8 @@ def test_a_table_row_becomes_a_profile_or_one_line(tmp_path):
     assert [ly.thickness for ly in a.profile.layers] == [0.15, 0.04] and a.profile.slope_angle == 0.0
     assert b.profile.country == "US"                           # vertical ends, as the row asks
     assert bad.profile is None
-    assert bad.refusal == "psts.csv: row 4 (no-slope): slope_deg is empty (a number is required)"
+    assert bad.refusal == ("psts.csv: row 4 (no-slope): slope_deg is empty (required: a slope in [0, 60] deg (the "
+                           "model takes slopes of 0-60 deg))")
     (tmp_path / "broken.csv").write_text("id,outcome\nx,End\n")
     with pytest.raises(ValueError, match="columns slope_deg, column_cm, cut_cm, weak_layer_cm are missing"):
         table_profiles(tmp_path / "broken.csv")
@@ -69,6 +70,7 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     assert again.skipped == 1 and len(again.records) == 2 and os.stat(done).st_mtime_ns == stamp
     assert all(r["status"] == "ok" for r in again.records)
     assert [r["observed"] for r in again.records] == ["END", "ARR"]
+    assert [r["w_f_source"] for r in again.records] == ["given", "given"]     # the table's w_f, not read back
     assert all(r["predicted"] in ("END", "SF", "ARR", "NP", "running") for r in again.records)
     # each record carries the slab's peak stress over its strength, the model's probabilities from it, weac's peak
     # ratio at the recorded cut and the information bar's numbers (the 12 cm cut of a 40 cm column: 0.3)

@@ -21,8 +21,9 @@ import tempfile
 import time
 import warnings
 
-from mpm_warp.field.batch import CASE_FEATURES, FieldBatch, finished_records, gather, run_cases, score_records
+from mpm_warp.field.batch import FieldBatch, finished_records, gather, run_cases, score_records
 from mpm_warp.field.draw import select
+from mpm_warp.field.information_bar import CASE_FEATURES
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser

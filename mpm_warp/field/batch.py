@@ -9,6 +9,10 @@ cluster or on a running scheduler, and writes to ``out_dir``::
     cases.csv            one row per case: observed against predicted, recorded cut against the runaway cut
     scores.json          confusion matrix, recall per class, balanced accuracy; the same for the baselines
     confusion.png        the confusion matrix
+    dask.log             Dask's own logs (unless verbose: then on the terminal)
+
+The inputs are set up lazily (:mod:`.batch_setup`) and each runnable case is submitted once set up, so a large
+table's first case starts at once; a batch with a ``limit`` sets up rows only until it has that many.
 
 A batch killed at any point resumes where it stopped: a case whose JSON says "ok" and whose run file reads
 back is not run again. A case that raises is recorded as failed with its error and never stops the others.
@@ -20,8 +24,10 @@ import contextlib
 import csv
 import glob
 import hashlib
+import itertools
 import json
 import os
+import re
 import sys
 import time
 import traceback
@@ -30,14 +36,15 @@ from dataclasses import dataclass
 
 from .. import io
 from ..errors import InvalidArgument
-from .cases import FieldCase, FieldRefusal, field_case, field_cases
+from .batch_setup import Progress, check_out_dir, check_scheduler, dask_client, dask_log, iter_gather
+from .cases import FieldCase, FieldRefusal
+from .information_bar import CASE_FEATURES, case_record_features
 from .plain_words import in_field_terms
 from .probability import outcome_probability
 from .protocol import FieldProtocol, decided, protocol_params
 from .scores import field_class
 from .scoring import score_records
 from .static_rule import weac_static_rule
-from .table import table_profiles
 
 __all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "run_records", "case_digest",
            "case_scenario", "FieldBatch"]
@@ -54,30 +61,16 @@ class FieldBatch:
     out_dir: str
 
 
-def gather(inputs, calibrate: bool = True) -> tuple[list[FieldCase], list[FieldRefusal]]:
-    """The cases and refusals of every input: a folder of CAAML files (``*.xml``, ``*.caaml``), one CAAML file,
-    or a CSV table of PSTs (:mod:`.table`). ``calibrate=False`` leaves the weak layer's calibration to the run
-    (a selection from many records then calibrates only what it runs)."""
+def gather(inputs, calibrate: bool = True, limit: int | None = None) -> tuple[list[FieldCase], list[FieldRefusal]]:
+    """The cases and refusals of every input: a folder of CAAML files (``*.xml``, ``*.caaml``, any case), one
+    CAAML file, or a CSV table of PSTs (:mod:`.table`). ``calibrate=False`` leaves the weak layer's calibration to
+    the run (a selection from many records then calibrates only what it runs). With ``limit``, the inputs are set
+    up only until ``limit`` cases are found (the refusals met on the way are kept)."""
     cases, refused = [], []
-    for path in inputs:
-        path = os.fspath(path)
-        if os.path.isdir(path):
-            files = sorted(glob.glob(os.path.join(path, "*.xml")) + glob.glob(os.path.join(path, "*.caaml")))
-        elif path.lower().endswith(".csv"):
-            for row in table_profiles(path):
-                if row.refusal is not None:
-                    refused.append(FieldRefusal(os.path.basename(path), row.id, "table row", row.refusal))
-                    continue
-                r = field_case(row.profile, row.record, w_f=row.w_f, calibrate=calibrate)
-                (cases if isinstance(r, FieldCase) else refused).append(r)
-            continue
-        elif os.path.isfile(path):
-            files = [path]
-        else:
-            raise InvalidArgument("INPUT", path, "a folder of CAAML files, a CAAML file or a CSV table of PSTs")
-        for f in files:
-            for r in field_cases(f, calibrate=calibrate):
-                (cases if isinstance(r, FieldCase) else refused).append(r)
+    for r in iter_gather(inputs, calibrate=calibrate):
+        (cases if isinstance(r, FieldCase) else refused).append(r)
+        if limit is not None and len(cases) >= limit:
+            break
     return cases, refused
 
 
@@ -88,24 +81,15 @@ def case_digest(case: FieldCase, proto: FieldProtocol) -> str:
     return hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
-#: what a case record says of the observer's column: the information bar's numbers (:mod:`.information_bar`)
-CASE_FEATURES = ("slab_depth", "slab_density", "slope_deg", "column_length", "cut_share")
-
-
-def case_record_features(case: FieldCase) -> dict:
-    """The column's bed-normal slab depth (m), mean slab density (kg/m^3), slope (deg), column length (m) and
-    recorded cut over column length (-): :data:`CASE_FEATURES`."""
-    p = case.params
-    slab = p.slab_stack()
-    depth = sum(ly.thickness for ly in slab)
-    return {"slab_depth": float(depth), "slab_density": sum(ly.thickness * ly.density for ly in slab) / depth,
-            "slope_deg": float(p.slope_angle), "column_length": float(p.length),
-            "cut_share": float(case.record.cut_length) / float(p.length)}
+#: what a case's file name may not hold (a separator above all)
+_UNSAFE = re.compile(r"[^\w.-]")
 
 
 def _case_id(case: FieldCase, k: int, proto: FieldProtocol) -> str:
+    """The case's file name in ``--out``: its pit's name (any character but letters, digits, ``.``, ``_`` and
+    ``-`` replaced, so that an id ``a/b`` or ``../..`` stays a file inside the folder), its position, its key."""
     stem = os.path.splitext(case.pit)[0].replace("#", "-").replace(" ", "_")
-    return f"{stem}-{k}-{case_digest(case, proto)}"
+    return f"{_UNSAFE.sub('_', stem)}-{k}-{case_digest(case, proto)}"
 
 
 def _write_json(path: str, obj: dict) -> None:
@@ -155,6 +139,8 @@ def run_case(task: dict) -> dict:
 
 
 def _finished(task: dict) -> dict | None:
+    """The task's record from an earlier batch when it finished; None (run it again) where its file says otherwise,
+    whatever it holds (``[]``, a truncated file)."""
     return io.finished_record(os.path.join(task["out_dir"], task["id"]))
 
 
@@ -175,7 +161,7 @@ def run_records(run_dirs) -> list[tuple[dict, str]]:
         for path in sorted(glob.glob(os.path.join(run_dir, "*.json"))):
             with open(path) as fh:
                 r = json.load(fh)
-            if r.get("status") == "ok" and "predicted" in r:
+            if isinstance(r, dict) and r.get("status") == "ok" and "predicted" in r:
                 out.append((r, run_dir))
     return out
 
@@ -202,47 +188,49 @@ def case_scenario(case: FieldCase, proto: FieldProtocol):
     return (None, note) if params is None else (build(params, tc, name="field"), note)
 
 
+def _task(c: FieldCase, k: int, out_dir, proto, device, refused) -> dict | None:
+    """The task of the ``k``-th case ``c``, or None with its refusal added to ``refused``."""
+    try:
+        scenario, note = case_scenario(c, proto)
+        if scenario is None:
+            refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
+            return None
+        params = scenario.scene
+    except InvalidArgument as e:
+        refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, c.params), c.outcome))
+        return None
+    wf = c.fracture_energy
+    source = "given" if wf.reason == "given" else ("read back" if wf.value is not None else wf.reason)
+    static = weac_static_rule(c.params)
+    return {"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
+            "recorded_cut": c.record.cut_length, **case_record_features(c), "static_class": static["class"],
+            "static_peak_ratio": static["peak_ratio"], "w_f": params.weak_layer.w_f, "w_f_source": source,
+            "setup": note, "scenario": scenario, "out_dir": out_dir, "device": device, "threads": proto.threads}
+
+
 def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
-    tasks = []
-    for k, c in enumerate(cases):
-        try:
-            scenario, note = case_scenario(c, proto)
-            if scenario is None:
-                refused.append(FieldRefusal(c.pit, c.test, "budget", note, c.outcome))
-                continue
-            params = scenario.scene
-        except InvalidArgument as e:
-            refused.append(FieldRefusal(c.pit, c.test, *in_field_terms(e, c.params), c.outcome))
-            continue
-        wf = c.fracture_energy
-        static = weac_static_rule(c.params)
-        tasks.append({"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
-                      "recorded_cut": c.record.cut_length, **case_record_features(c),
-                      "static_class": static["class"], "static_peak_ratio": static["peak_ratio"],
-                      "w_f": params.weak_layer.w_f, "w_f_source": "read back" if wf.value is not None else wf.reason,
-                      "setup": note, "scenario": scenario, "out_dir": out_dir,
-                      "device": device, "threads": proto.threads})
-    return tasks
+    tasks = (_task(c, k, out_dir, proto, device, refused) for k, c in enumerate(cases))
+    return [t for t in tasks if t is not None]
 
 
-def _execute(todo, records, workers, scheduler, stream, total, threads=1) -> None:
-    from distributed import Client, LocalCluster, as_completed
+def _execute(todo, records, workers, scheduler, progress: Progress, threads=1, out_dir=".", verbose=False) -> None:
+    """Run the tasks of the iterator ``todo`` as they come (each submitted once set up, so the first case starts
+    while the later rows are set up) and put their records in ``records``; no cluster where there is none."""
+    from distributed import as_completed
 
+    first = next(todo, None)
+    if first is None:
+        return
     with contextlib.ExitStack() as stack:
-        if scheduler:
-            client = stack.enter_context(Client(scheduler))
-        else:
-            cluster = stack.enter_context(LocalCluster(
-                n_workers=workers or max(1, (os.cpu_count() or 1) // threads), threads_per_worker=1, processes=True,
-                dashboard_address=None, silence_logs=40, env={"MPM_WARP_THREADS": str(threads)}))
-            client = stack.enter_context(Client(cluster))
+        terminal = stack.enter_context(dask_log(out_dir, verbose))
+        if progress.stream is sys.stderr:
+            progress.stream = terminal
+        client = dask_client(stack, scheduler, workers, threads, verbose)
         n_workers = len(client.scheduler_info().get("workers", {})) or None
-        todo = [{**t, "workers": n_workers} for t in todo]    # each record says how many cases ran beside it
-        token, t0, done = uuid.uuid4().hex[:8], time.perf_counter(), 0
-        futures = {client.submit(run_case, t, key=f"{t['id']}-{token}", retries=1, pure=False, priority=-i): t
-                   for i, t in enumerate(todo)}
-        for fut in as_completed(list(futures)):
-            task = futures[fut]
+        token, futures, running = uuid.uuid4().hex[:8], {}, as_completed()
+
+        def collect(fut):
+            task = futures.pop(fut)
             try:
                 rec = fut.result()
             except Exception as e:   # the worker died too often, or the cluster is gone
@@ -250,19 +238,25 @@ def _execute(todo, records, workers, scheduler, stream, total, threads=1) -> Non
                 _write_json(os.path.join(task["out_dir"], task["id"] + ".json"), rec)
             fut.release()
             records[task["id"]] = rec
-            done += 1
-            if stream is not None:
-                el = time.perf_counter() - t0
-                stream.write(f"\rfield: {total - len(todo) + done}/{total} cases, elapsed {el:.0f} s, "
-                             f"ETA {el / done * (len(todo) - done):.0f} s ")
-                stream.flush()
-        if stream is not None:
-            stream.write("\n")
+            progress.done += 1
+            progress.show()
+
+        for i, t in enumerate(itertools.chain([first], todo)):
+            t = {**t, "workers": n_workers}    # each record says how many cases ran beside it
+            fut = client.submit(run_case, t, key=f"{t['id']}-{token}", retries=1, pure=False, priority=-i)
+            futures[fut] = t
+            running.add(fut)
+            while running.has_ready():
+                collect(next(running))
+        progress.setting_up = False
+        for fut in running:
+            collect(fut)
+        progress.stream = sys.stderr if progress.stream is terminal else progress.stream
 
 
 def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
               device: str | None = "cpu", protocol: FieldProtocol | None = None, limit: int | None = None,
-              progress=True) -> FieldBatch:
+              progress=True, verbose: bool = False) -> FieldBatch:
     """Set up, run and score every PST record of ``inputs`` (module docstring).
 
     Parameters
@@ -281,40 +275,99 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
     protocol : FieldProtocol, optional
         The per-case budget and the saw (default :class:`~.protocol.FieldProtocol`).
     limit : int, optional
-        Run only the first ``limit`` runnable cases (in input order).
+        Run only the first ``limit`` runnable cases (in input order): the inputs are set up only until that many
+        are found, and a refused record does not count.
     progress : bool or text stream
         One progress line on stderr (True), on the given stream, or none.
+    verbose : bool
+        Dask's logs on the terminal; else in ``dask.log`` in ``out_dir``.
     """
     if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
         raise InvalidArgument("limit", limit, "an integer >= 1")
-    cases, refused = gather(inputs)
-    return run_cases(cases[:limit] if limit is not None else cases, refused, out_dir, workers=workers,
-                     scheduler=scheduler, device=device, protocol=protocol, progress=progress)
+    proto = _checked(workers, scheduler, protocol, out_dir)
+    items, refused, shown = iter_gather(inputs), [], Progress(_stream(progress))
+
+    def setup():
+        cases = runnable = 0
+        for item in items:
+            shown.records += 1
+            if isinstance(item, FieldCase):
+                task = _task(item, cases, out_dir, proto, device, refused)
+                cases += 1
+                if task is not None:
+                    yield task
+                    runnable += 1
+                    if limit is not None and runnable >= limit:
+                        return
+            else:
+                refused.append(item)
+            shown.refused = len(refused)
+            shown.show()
+
+    return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose)
 
 
-def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
-              device: str | None = "cpu", protocol: FieldProtocol | None = None, progress=True) -> FieldBatch:
-    """Run the field cases ``cases`` (:func:`gather`'s, or a selection of them) and score them, as :func:`run_field`;
-    ``refused`` (their refusals) goes to ``refused.csv``."""
+def _checked(workers, scheduler, protocol, out_dir) -> FieldProtocol:
+    """The batch's protocol, once its arguments and its folder are checked (before anything is set up)."""
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise InvalidArgument("workers", workers, "an integer >= 1")
     proto = (protocol or FieldProtocol()).validate()
-    refused = list(refused)
-    os.makedirs(out_dir, exist_ok=True)
-    tasks = _tasks(cases, out_dir, proto, device, refused)
-    records = {t["id"]: _finished(t) for t in tasks}
-    todo = [t for t in tasks if records[t["id"]] is None]
-    stream = sys.stderr if progress is True else (progress or None)
-    if todo:
-        _execute(todo, records, workers, scheduler, stream, len(tasks), proto.threads)
-    recs = [records[t["id"]] for t in tasks]
+    check_scheduler(scheduler)
+    check_out_dir(out_dir)
+    return proto
+
+
+def _stream(progress):
+    return sys.stderr if progress is True else (progress or None)
+
+
+def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
+              device: str | None = "cpu", protocol: FieldProtocol | None = None, progress=True,
+              verbose: bool = False) -> FieldBatch:
+    """Run the field cases ``cases`` (:func:`gather`'s, or a selection of them) and score them, as :func:`run_field`;
+    ``refused`` (their refusals) goes to ``refused.csv``."""
+    proto = _checked(workers, scheduler, protocol, out_dir)
+    refused, shown = list(refused), Progress(_stream(progress))
+
+    def setup():
+        for k, c in enumerate(cases):
+            shown.records += 1
+            task = _task(c, k, out_dir, proto, device, refused)
+            if task is not None:
+                yield task
+
+    return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose)
+
+
+def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Progress, verbose) -> FieldBatch:
+    """Run the tasks of the iterator ``tasks`` not finished in ``out_dir`` before, as they are set up; write the
+    records, the refusals and the scores."""
+    done, ran, records = [], [], {}
+
+    def todo():
+        for t in tasks:
+            done.append(t)
+            progress.tasks = len(done)
+            progress.refused = len(refused)
+            records[t["id"]] = _finished(t)
+            if records[t["id"]] is None:
+                ran.append(t)
+                yield t
+            else:
+                progress.done += 1
+            progress.show()
+
+    _execute(todo(), records, workers, scheduler, progress, proto.threads, out_dir, verbose)
+    progress.refused = len(refused)
+    progress.end()
+    recs = [records[t["id"]] for t in done]
     _write_outputs(out_dir, recs, refused)
     sc = score_records(recs)
     _write_json(os.path.join(out_dir, "scores.json"), sc)
     from .figures import plot_confusion
 
     plot_confusion(sc, os.path.join(out_dir, "confusion.png"))
-    return FieldBatch(recs, refused, sc, len(tasks) - len(todo), out_dir)
+    return FieldBatch(recs, refused, sc, len(done) - len(ran), out_dir)
 
 
 #: the columns of cases.csv
@@ -325,11 +378,11 @@ CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "p_end",
 
 
 def _write_outputs(out_dir: str, recs: list, refused: list) -> None:
-    with open(os.path.join(out_dir, "cases.csv"), "w", newline="") as fh:
+    with open(os.path.join(out_dir, "cases.csv"), "w", newline="", encoding="utf-8") as fh:
         w = csv.DictWriter(fh, CASE_COLUMNS, extrasaction="ignore")
         w.writeheader()
         w.writerows(recs)
-    with open(os.path.join(out_dir, "refused.csv"), "w", newline="") as fh:
+    with open(os.path.join(out_dir, "refused.csv"), "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(["pit", "test", "outcome", "reason", "message"])
         w.writerows([r.pit, r.test, r.outcome or "", r.reason, r.message] for r in refused)

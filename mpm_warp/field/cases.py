@@ -23,7 +23,8 @@ from ..scenes.snowpack import SnowLayer
 from .fracture_energy import ImpliedFractureEnergy, implied_fracture_energy
 from .plain_words import in_field_terms
 
-__all__ = ["FieldCase", "FieldRefusal", "field_case", "field_cases", "field_base", "OUTCOMES", "column_ends_for"]
+__all__ = ["FieldCase", "FieldRefusal", "field_case", "field_cases", "field_base", "OUTCOMES", "column_ends_for",
+           "pit_name"]
 
 OUTCOMES = ("End", "SF", "Arr")
 #: countries whose standard PST has vertical ends (the North American guidelines, Greene et al. 2016)
@@ -81,6 +82,15 @@ def field_base() -> PSTParams:
 def column_ends_for(country: str | None) -> str:
     """The column ends of the observer's standard: "vertical" in the US and Canada, else "slope_normal"."""
     return "vertical" if (country or "").strip().upper() in VERTICAL_ENDS else "slope_normal"
+
+
+def pit_name(source: str) -> str:
+    """The pit's name in the records: a CAAML file's base name, or ``table.csv#id`` for a table's row (its id
+    whole, ``a/b`` included: only a file name made of it is sanitised)."""
+    file, _, rid = str(source).partition("#")
+    if rid and file.lower().endswith(".csv") and os.path.basename(file) == file:
+        return str(source)
+    return os.path.basename(str(source))
 
 
 def _refuse(pit, rec, reason, message) -> FieldRefusal:
@@ -148,7 +158,7 @@ def field_case(profile: SnowProfileData, rec: PSTRecord, *, base: PSTParams | No
     w_f : float, optional
         The weak layer's fracture energy (J/m^2) when known (a table gives it); else read back from the cut.
     """
-    pit = os.path.basename(profile.source)
+    pit = pit_name(profile.source)
     why = _triage(rec, profile)
     if why is not None:
         return _refuse(pit, rec, *why)

@@ -13,10 +13,26 @@ import numpy as np
 
 from .scores import FIELD_CLASSES
 
-__all__ = ["FEATURES", "case_features", "fold_count", "grouped_folds", "information_bar"]
+__all__ = ["FEATURES", "CASE_FEATURES", "case_record_features", "case_features", "fold_count", "grouped_folds",
+           "information_bar"]
 
 #: the recorded numbers the statistical model reads, and their units
 FEATURES = {"slab_depth": "m", "slab_density": "kg/m^3", "slope_deg": "deg", "cut_share": "-"}
+
+
+#: what a case record says of the observer's column: :data:`FEATURES` and the column's length
+CASE_FEATURES = ("slab_depth", "slab_density", "slope_deg", "column_length", "cut_share")
+
+
+def case_record_features(case) -> dict:
+    """The field case's (:class:`~.cases.FieldCase`) bed-normal slab depth (m), mean slab density (kg/m^3), slope
+    (deg), column length (m) and recorded cut over column length (-): :data:`CASE_FEATURES`."""
+    p = case.params
+    slab = p.slab_stack()
+    depth = sum(ly.thickness for ly in slab)
+    return {"slab_depth": float(depth), "slab_density": sum(ly.thickness * ly.density for ly in slab) / depth,
+            "slope_deg": float(p.slope_angle), "column_length": float(p.length),
+            "cut_share": float(case.record.cut_length) / float(p.length)}
 
 
 def case_features(rec: dict) -> list[float] | None:

@@ -31,11 +31,12 @@ def write_record(path: str, obj: dict, what: str, default=None) -> None:
 
 def finished_record(out: str) -> dict | None:
     """The record ``out.json`` of a case finished earlier ("ok", and ``out.h5`` reads back with its frames); else
-    None."""
+    None (a file holding anything else, ``[]`` included, is a case to run again)."""
     try:
         with open(out + ".json") as fh:
             rec = json.load(fh)
-        if rec.get("status") == "ok" and read_run(out + ".h5").n_frames == rec.get("n_frames"):
+        if (isinstance(rec, dict) and rec.get("status") == "ok"
+                and read_run(out + ".h5").n_frames == rec.get("n_frames")):
             return rec
     except (OSError, ValueError, MPMError):
         pass
