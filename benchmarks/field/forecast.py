@@ -22,6 +22,7 @@ import warnings
 import numpy as np
 
 from mpm_warp.field.draw import finished_draw
+from mpm_warp.field.scores import FIELD_CLASSES
 from mpm_warp.field.scoring import forecasts, score_records, scored
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -38,7 +39,7 @@ def reliability_figure(sc: dict, path: str) -> None:
 
     names = [n for n in ("model", "information_bar", "climatology", "weac_static") if n in sc["forecast"]]
     fig, axes = plt.subplots(1, 3, figsize=(12, 4.2), sharey=True)
-    for ax, cls in zip(axes, ("END", "SF", "ARR"), strict=True):
+    for ax, cls in zip(axes, FIELD_CLASSES, strict=True):
         ax.plot([0, 1], [0, 1], color="0.6", lw=1, ls="--", label="perfectly reliable")
         for name in names:
             t = sc["forecast"][name]["reliability"][cls]
@@ -62,7 +63,7 @@ def made_up(n: int = 30, seed: int = 0) -> list[dict]:
     rng = np.random.default_rng(seed)
     recs = []
     for i in range(n):
-        obs = ("END", "SF", "ARR")[i % 3]
+        obs = FIELD_CLASSES[i % 3]
         recs.append({"id": f"c{i}", "pit": f"p{i // 2}", "status": "ok", "observed": obs,
                      "predicted": "SF" if obs == "SF" and i % 2 else "END", "static_class": "END",
                      "slab_peak_stress_ratio": float(rng.uniform(0.2, 1.2)), "slab_depth": float(rng.uniform(0.2, 0.8)),

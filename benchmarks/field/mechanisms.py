@@ -23,7 +23,7 @@ import warnings
 
 from mpm_warp.field.batch import gather
 from mpm_warp.field.mechanisms import brittleness, touchdown_distance
-from mpm_warp.field.scores import scores
+from mpm_warp.field.scores import FIELD_CLASSES, scores
 from mpm_warp.field.static_rule import weac_static_rule
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -74,7 +74,7 @@ def table(rows: list[dict]) -> dict:
     out = {}
     for key, (what, sign) in CANDIDATES.items():
         med = {c: statistics.median(v) if (v := [r[key] for r in rows if r["observed"] == c and r[key] is not None])
-               else None for c in ("END", "SF", "ARR")}
+               else None for c in FIELD_CLASSES}
         out[key] = {"what": what, "direction": "larger: SF" if sign > 0 else "smaller: SF",
                     "sf_vs_end": auc(rows, key, sign, "SF", ("END",)),
                     "arr_vs_rest": auc(rows, key, sign, "ARR", ("END", "SF")), "median": med}
@@ -109,7 +109,7 @@ def main(argv=None) -> int:
     described = [describe(r, by[case_key(r)]) for r in rows]
     data = {"name": "field_mechanisms", "cases_from": os.path.basename(args.cases),
             "data": os.path.basename(os.path.normpath(args.data)), "environment": environment("cpu"),
-            "counts": {c: sum(r["observed"] == c for r in described) for c in ("END", "SF", "ARR")},
+            "counts": {c: sum(r["observed"] == c for r in described) for c in FIELD_CLASSES},
             "candidates": table(described), "touchdown_rule": touchdown_rule(described), "cases": described}
     path = write_json("field_mechanisms", data, out_dir(args, RESULTS, "field_mechanisms"))
     for key, v in data["candidates"].items():

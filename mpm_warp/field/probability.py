@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import math
 
+from ..scenes.pst.outcome import CLASSES
+
 __all__ = ["WEIBULL_MODULUS", "weibull_break_probability", "outcome_probability", "probability_line"]
 
 #: Weibull modulus of snow's tensile strength (-), Phys. Rev. E 69, 011306 (2004)
@@ -34,7 +36,7 @@ def outcome_probability(predicted: str | None, slab_peak_stress_ratio: float | N
     strength ``slab_peak_stress_ratio`` (module docstring); None for a run without a field class or a ratio
     (an older record, "running", failed)."""
     r = slab_peak_stress_ratio
-    if predicted not in ("END", "SF", "ARR", "NP") or not isinstance(r, (int, float)) or not r == r:
+    if predicted not in CLASSES or not isinstance(r, (int, float)) or not r == r:
         return None
     p_sf = weibull_break_probability(min(float(r), 1.0), modulus)
     if predicted in ("ARR", "NP"):

@@ -14,9 +14,10 @@ from __future__ import annotations
 
 from collections import Counter
 
+from ..scenes.pst.outcome import FIELD_CLASSES
+
 __all__ = ["FIELD_CLASSES", "field_class", "confusion", "scores", "baseline_majority"]
 
-FIELD_CLASSES = ("END", "SF", "ARR")
 
 
 def field_class(outcome: str | None) -> str | None:

@@ -30,11 +30,13 @@ import numpy as np
 from .analysis import crack_ran, end_zone
 from .params import PSTParams
 
-__all__ = ["SlabCrackDetector", "classify", "field_line", "front_stalled", "CLASSES", "THROUGH_DAMAGE", "THROUGH_COVER",
-           "STALL_TIME"]
+__all__ = ["SlabCrackDetector", "classify", "field_line", "front_stalled", "FIELD_CLASSES", "CLASSES", "THROUGH_DAMAGE",
+           "THROUGH_COVER", "STALL_TIME"]
 
+#: the field's three classes, in the order of the forecast scores (docs/field.md): the one home of their spelling
+FIELD_CLASSES = ("END", "SF", "ARR")
 #: the classes of :func:`classify`: the field's three and no propagation (``saw.stop = "runaway"`` only)
-CLASSES = ("END", "SF", "ARR", "NP")
+CLASSES = (*FIELD_CLASSES, "NP")
 
 #: damage (-) at which a slab particle is cracked through
 THROUGH_DAMAGE = 0.95

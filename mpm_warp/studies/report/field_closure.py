@@ -4,11 +4,10 @@ from __future__ import annotations
 
 from statistics import median
 
+from ...scenes.pst.outcome import FIELD_CLASSES as CLASSES
 from .core import section
 from .field_rigid_base import CUT_SHARE, _cut
 from .fmt import check_line, count, env_note, fx, spct, table
-
-CLASSES = ("END", "SF", "ARR")
 
 
 def _change(c: dict):

@@ -3,6 +3,7 @@ scores of the model against the climatology, the majority class, weac's rule and
 
 from __future__ import annotations
 
+from ...field.scores import FIELD_CLASSES
 from .core import section
 from .fmt import check_line, env_note, fx, table
 
@@ -24,7 +25,7 @@ def _iv(iv, nd: int = 2) -> str:
 def render_mechanisms(data: dict, ctx) -> list[str]:
     c = data["candidates"]
     rows = [[f"`{k}`", v["what"], v["direction"], fx(v["sf_vs_end"]["auc"], 3), fx(v["arr_vs_rest"]["auc"], 3),
-             " / ".join(fx(v["median"][k2], 3) for k2 in ("END", "SF", "ARR"))] for k, v in c.items()]
+             " / ".join(fx(v["median"][k2], 3) for k2 in FIELD_CLASSES)] for k, v in c.items()]
     n = data["counts"]
     out = [f"On the {sum(n.values())} scored columns of the development set's two batches (END {n['END']}, SF "
            f"{n['SF']}, ARR {n['ARR']}; `{data['cases_from']}`), each set up again from its pit. AUC: the chance "
@@ -70,10 +71,10 @@ def render_forecast(data: dict, ctx) -> list[str]:
             continue
         s, i = f[name], iv.get(name, {})
         rows.append([name, fx(s["rps"], 3), fx(s["rpss"], 2) + _iv(i.get("rpss")),
-                     " / ".join(fx(s["brier"][k], 3) for k in ("END", "SF", "ARR")),
+                     " / ".join(fx(s["brier"][k], 3) for k in FIELD_CLASSES),
                      fx(s["auc"]["SF"], 2) + _iv(i.get("auc_SF")), fx(s["auc"]["ARR"], 2) + _iv(i.get("auc_ARR")),
                      fx(s["balanced_accuracy"], 2) + _iv(i.get("balanced_accuracy"))])
-    drawn = sum(sel.get(k, 0) for k in ("END", "SF", "ARR"))
+    drawn = sum(sel.get(k, 0) for k in FIELD_CLASSES)
     out = [f"The first {sc['cases']} finished cases of the stratified draw ({drawn} drawn, {sel.get('per_class')} a "
            f"class, seed {sel.get('seed')}), interleaved by class. The model: one run a case, read at first order "
            "(its slab's peak stress under snow's Weibull strength scatter, docs/field.md). Intervals: 95 %, paired "
