@@ -7,7 +7,8 @@ strength at the recorded cut) and closed forms from published laws (``mpm_warp.f
 touchdown distance against the column, the slab's brittleness). For each: the SF-against-END AUC (scikit-learn;
 the direction each candidate's physics says: a shorter touchdown distance, a larger stress ratio mean SF), the
 ARR-against-the-rest AUC, and the medians by observed class. A candidate's rule, where it has one (SF where the
-slab touches down inside the column), is scored as classes too. Nothing is fitted. Writes
+slab touches down inside the column), is scored as classes too, and the information bar (the records' four numbers
+in a logistic regression cross-validated by pit) is scored beside them. Nothing physical is fitted. Writes
 ``benchmarks/field/results/field_mechanisms.json``.
 
 Usage: ``python benchmarks/field/mechanisms.py --data DIR`` (DIR: the unpacked pits); ``--quick``: 24 cases.
@@ -89,6 +90,23 @@ def touchdown_rule(rows: list[dict]) -> dict:
     return {"rule": "SF where touchdown_over_column < 1, else END", **scores(obs, pred)}
 
 
+def information_bar_scores(rows: list[dict], described: list[dict]) -> dict:
+    """The information bar (``mpm_warp.field.information_bar``) on the same columns: its cross-validated
+    P(SF)'s SF-against-END AUC, and its forecast scores (:func:`~mpm_warp.field.forecast.forecast_scores`)."""
+    from sklearn.metrics import roc_auc_score
+
+    from mpm_warp.field.forecast import forecast_scores
+    from mpm_warp.field.information_bar import information_bar
+
+    obs = [r["observed"] for r in described]
+    feats = [[r["slab_depth_m"], r["slab_density"], r["slope_deg"], r["cut_share"]] for r in rows]
+    prob = information_bar(feats, obs, [case_key(r)[0] for r in rows])
+    sf_end = [i for i, o in enumerate(obs) if o in ("SF", "END")]
+    sc = forecast_scores(obs, prob)
+    sc.pop("reliability")
+    return {"auc_sf_vs_end": float(roc_auc_score([obs[i] == "SF" for i in sf_end], prob[sf_end, 1])), **sc}
+
+
 def main(argv=None) -> int:
     p = parser(__doc__, "the first 24 cases")
     p.add_argument("--data", required=True, help="folder of CAAML files the batches read")
@@ -110,7 +128,8 @@ def main(argv=None) -> int:
     data = {"name": "field_mechanisms", "cases_from": os.path.basename(args.cases),
             "data": os.path.basename(os.path.normpath(args.data)), "environment": environment("cpu"),
             "counts": {c: sum(r["observed"] == c for r in described) for c in FIELD_CLASSES},
-            "candidates": table(described), "touchdown_rule": touchdown_rule(described), "cases": described}
+            "candidates": table(described), "touchdown_rule": touchdown_rule(described),
+            "information_bar": information_bar_scores(rows, described), "cases": described}
     path = write_json("field_mechanisms", data, out_dir(args, RESULTS, "field_mechanisms"))
     for key, v in data["candidates"].items():
         print(f"{key:24s} SF/END AUC {v['sf_vs_end']['auc']:.3f}  ARR/rest AUC {v['arr_vs_rest']['auc']:.3f}")

@@ -43,6 +43,7 @@ def render_mechanisms(data: dict, ctx) -> list[str]:
     out += [f"- **The touchdown rule** ({r['rule']}: the slab lands on its collapsed weak layer inside the column): "
             f"balanced accuracy {fx(r['balanced_accuracy'], 2)}, recall END {fx(r['recall']['END'], 2)}, SF "
             f"{fx(r['recall']['SF'], 2)}, ARR {fx(r['recall']['ARR'], 2)} on these {r['n']} columns.",
+            *_bar_line(data.get("information_bar")),
             f"- **The run's own slab** (`run_slab_crack_ratio`, its largest effective stress over strength) "
             f"scores {fx(c['run_slab_crack_ratio']['sf_vs_end']['auc'], 3)}, and weac's static stress at the "
             f"recorded cut {fx(c['static_peak_ratio']['sf_vs_end']['auc'], 3)}: neither tells the SF records from the "
@@ -52,6 +53,17 @@ def render_mechanisms(data: dict, ctx) -> list[str]:
             "slabs are the least brittle by this measure (the shortest depth for their characteristic length), so "
             "brittleness does not explain why they break.", "", env_note(data)]
     return out
+
+
+def _bar_line(bar: dict | None) -> list[str]:
+    """The information bar's line on the mechanisms' columns (none in an older file)."""
+    if not bar:
+        return []
+    return [f"- **The information bar** (slab depth, density, slope and cut share in a logistic regression, "
+            f"cross-validated by pit) on the same columns: SF-against-END AUC {fx(bar['auc_sf_vs_end'], 3)}, "
+            f"balanced accuracy {fx(bar['balanced_accuracy'], 2)} (recall END {fx(bar['recall']['END'], 2)}, SF "
+            f"{fx(bar['recall']['SF'], 2)}, ARR {fx(bar['recall']['ARR'], 2)}), ranked probability skill "
+            f"{fx(bar['rpss'], 2)} against the set's climatology."]
 
 
 @section("field", "The outcome as a probability: forecast scores", "field/results/field_forecast.json",
