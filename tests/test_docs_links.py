@@ -1,4 +1,4 @@
-"""Every relative link, #anchor and repository path that README.md and docs/*.md name exists.
+"""Every relative link, #anchor and repository path that README.md, docs/*.md and the results pages name exists.
 
 Links are Markdown links and images (``[text](target)``); anchors are checked against the headings of the
 file they point into, as GitHub renders them (lower case, spaces to '-', punctuation dropped, a repeated
@@ -18,7 +18,8 @@ import pytest
 from mpm_warp.studies.report.core import slug
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-DOCS = ["README.md", *sorted(os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, "docs", "*.md")))]
+DOCS = ["README.md", *sorted(os.path.relpath(p, ROOT) for pattern in ("*.md", "results/*.md")
+                             for p in glob.glob(os.path.join(ROOT, "docs", pattern)))]
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
 CODE = re.compile(r"`([^`]+)`")
 TOP = {d for d in os.listdir(ROOT) if os.path.isdir(os.path.join(ROOT, d)) and not d.startswith(".")

@@ -1,7 +1,8 @@
-"""Every comparison with a reference in docs/results.md has a pass line: its criterion and pass, FAIL or open
-(issue 37, part 2). The lines come from mpm_warp.studies.report; here their format, a fail kept with its
+"""Every comparison with a reference in the results pages (docs/results/) has a pass line: its criterion and pass,
+FAIL or open (issue 37, part 2). The lines come from mpm_warp.studies.report; here their format, a fail kept with its
 explanation, and their presence in each comparing section of the committed document."""
 
+import glob
 import os
 import re
 
@@ -13,7 +14,7 @@ from mpm_warp.studies.report.snowpack import ends_checks, outcome_checks
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-#: the sections of docs/results.md that compare with a reference (weac, FE or closed forms, field ranges, Heierli),
+#: the sections of the results pages that compare with a reference (weac, FE or closed forms, field ranges, Heierli),
 #: and how many pass lines each shows today
 COMPARING = {"Error against run time: the reference problems": 2,
              "The weak layer's collapse under a slab: mesh study": 2,
@@ -45,15 +46,19 @@ def test_a_pass_line_says_its_criterion_and_keeps_a_fail_with_its_reason():
     assert check_line("x", "the field", None, "no text") == "- **Check, x:** the field: **open** (no text)."
 
 
-def _sections(text: str) -> dict[str, str]:
-    parts = re.split(r"^### (.+)$", text, flags=re.M)
-    return dict(zip(parts[1::2], parts[2::2], strict=True))
+def _sections() -> dict[str, str]:
+    """Every section of the committed results pages: its title -> its text."""
+    out = {}
+    for page in glob.glob(os.path.join(ROOT, "docs", "results", "*.md")):
+        with open(page) as fh:
+            parts = re.split(r"^## (.+)$", fh.read(), flags=re.M)
+        out.update(zip(parts[1::2], parts[2::2], strict=True))
+    return out
 
 
 @pytest.mark.parametrize("title", sorted(COMPARING))
 def test_each_comparing_section_shows_its_pass_lines(title):
-    with open(os.path.join(ROOT, "docs", "results.md")) as fh:
-        sections = _sections(fh.read())
+    sections = _sections()
     lines = [ln for ln in sections[title].splitlines() if ln.startswith("- **Check, ")]
     assert len(lines) == COMPARING[title], lines
     assert all(LINE.match(ln) for ln in lines), lines
@@ -153,6 +158,7 @@ def test_the_2d_elastic_step_fails_its_target_at_the_size_where_it_falls_short()
 def test_a_section_that_follows_another_lands_after_it_whichever_is_registered_first(monkeypatch, tmp_path):
     from mpm_warp.errors import InvalidArgument
     from mpm_warp.studies.report import core
+    from mpm_warp.studies.report.pages import generate
 
     monkeypatch.setattr(core, "SECTIONS", [])
     monkeypatch.setattr(core, "_WAITING", {})
@@ -162,7 +168,7 @@ def test_a_section_that_follows_another_lands_after_it_whichever_is_registered_f
     core.section("field", "f", "f.json", "cmd", follows="nowhere")(lambda data, ctx: [])
     (tmp_path / "benchmarks").mkdir()
     with pytest.raises(InvalidArgument, match="follows"):
-        core.document(core.Context(str(tmp_path)))
+        generate(core.Context(str(tmp_path)))
 
 
 def test_the_strength_study_asks_chance_with_fishers_exact_tail():

@@ -1,6 +1,6 @@
-"""docs/results.md and the README's headline numbers are generated from the committed benchmark JSON
-(``python -m mpm_warp.studies.report``): the committed files are current, and sections format a tiny JSON
-exactly as written (numbers from the data, a missing file skipped with one line)."""
+"""docs/results.md, the results pages under docs/results/ and the README's headline numbers are generated from the
+committed benchmark JSON (``python -m mpm_warp.studies.report``): the committed files are current, and sections
+format a tiny JSON exactly as written (numbers from the data, a missing file skipped with one line)."""
 
 from __future__ import annotations
 
@@ -11,9 +11,10 @@ import os
 import pytest
 
 from mpm_warp.errors import InvalidArgument
-from mpm_warp.studies.report import SECTIONS, Context, main, readme_text, results_markdown
-from mpm_warp.studies.report.core import document
+from mpm_warp.studies.report import SECTIONS, Context, main, readme_text, results_pages
+from mpm_warp.studies.report.core import PAGES
 from mpm_warp.studies.report.fmt import env_note, spct
+from mpm_warp.studies.report.pages import page_text
 from mpm_warp.studies.report.readme import BEGIN, END, with_block
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -25,11 +26,21 @@ def _diff(a: str, b: str) -> str:
     return "\n".join(list(d)[:30])
 
 
-def test_committed_results_md_is_current():
-    with open(os.path.join(ROOT, "docs", "results.md")) as fh:
-        committed = fh.read()
-    generated = results_markdown(ROOT)
-    assert generated == committed, f"docs/results.md is out of date: {FIX}\n{_diff(committed, generated)}"
+GENERATED = results_pages(ROOT)
+
+
+@pytest.mark.parametrize("rel", sorted(GENERATED))
+def test_committed_results_pages_are_current(rel):
+    path = os.path.join(ROOT, rel)
+    committed = open(path).read() if os.path.isfile(path) else ""
+    generated = GENERATED[rel]
+    assert generated == committed, f"{rel} is out of date: {FIX}\n{_diff(committed, generated)}"
+
+
+def test_every_results_page_is_generated_and_every_page_is_committed():
+    assert set(GENERATED) == {"docs/results.md"} | {p.path for p in PAGES.values()}
+    pages = os.path.join(ROOT, "docs", "results")
+    assert {f"docs/results/{f}" for f in os.listdir(pages) if f.endswith(".md")} == set(GENERATED) - {"docs/results.md"}
 
 
 def test_committed_readme_block_is_current():
@@ -92,15 +103,15 @@ def root(tmp_path):
 def _section(root, source):
     """The lines of one section's part of the document generated in ``root``, from its heading to the next."""
     sec = next(s for s in SECTIONS if s.source == source)
-    text = document(Context(root), [sec]).splitlines()
-    start = text.index(f"### {sec.title}")
+    text = page_text(Context(root), sec.page_key, [sec]).splitlines()
+    start = text.index(f"## {sec.title}")
     return text[start:]
 
 
 def test_shear_test_section_formats_the_json(root):
     lines = _section(root, "snow/results/snow_shear_test.json")
     assert "Command: `python benchmarks/snow/shear_test.py --cells 4 8`. Data: [`snow/results/snow_shear_test.json`]" \
-           "(../benchmarks/snow/results/snow_shear_test.json)." in lines
+           "(../../benchmarks/snow/results/snow_shear_test.json)." in lines
     assert "| quantity | 4 cells (dx 7.50 mm) | 8 cells (dx 3.75 mm) | reference |" in lines
     assert "| particles; steps; wall time | 1,234; 2,000; 12 s | 1,234; 2,000; 12 s |  |" in lines
     assert "| peak shear stress | 900.0 Pa (-10.0 %) | 1010.0 Pa (+1.0 %) | given tau_p 1000 Pa |" in lines
@@ -180,7 +191,7 @@ def test_main_writes_checks_and_leaves_a_readme_without_markers_alone(root, caps
     with open(os.path.join(root, "README.md")) as fh:
         text = fh.read()
     assert "- **Shear test:** peak 900.0 / 1010.0 Pa at 4 / 8 cells against the given tau_p 1000 Pa " \
-           "(-10.0 % / +1.0 %) ([Shear test](docs/results.md#shear-test))." in text
+           "(-10.0 % / +1.0 %) ([Shear test](docs/results/snow.md#shear-test))." in text
     assert "Throughput" not in text                                   # its JSON is not there: no bullet
     with pytest.raises(InvalidArgument, match="root"):
         Context(os.path.join(root, "docs"))

@@ -10,8 +10,9 @@ import pytest
 
 from mpm_warp.studies.fresh_clone import readme_commands, split_parts
 from mpm_warp.studies.report import Context
-from mpm_warp.studies.report.core import SECTIONS, document
+from mpm_warp.studies.report.core import SECTIONS
 from mpm_warp.studies.report.main_job import SOURCE, main_job_block
+from mpm_warp.studies.report.pages import page_text
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -48,9 +49,9 @@ def test_main_job_section_and_readme_line(tmp_path):
     with open(tmp_path / "benchmarks" / SOURCE, "w") as fh:
         json.dump(FRESH, fh)
     ctx = Context(str(tmp_path))
-    lines = document(ctx, [s for s in SECTIONS if s.source == SOURCE]).splitlines()
+    lines = page_text(ctx, "perf", [s for s in SECTIONS if s.source == SOURCE]).splitlines()
     assert "Command: `python benchmarks/perf/fresh_clone.py --tests`. Data: [`perf/results/fresh_clone.json`]" \
-           "(../benchmarks/perf/results/fresh_clone.json)." in lines
+           "(../../benchmarks/perf/results/fresh_clone.json)." in lines
     assert "| install and run the main job | `.venv/bin/pip install -e .` | 20 s | 0 |" in lines
     assert ("The main job: 1,000 particles, 2,000 steps, 5 frames, 0.0 M particle-steps/s over the run's wall time "
             "(compiling and pictures included); it wrote `pst.png`.") in lines
@@ -58,7 +59,7 @@ def test_main_job_section_and_readme_line(tmp_path):
         "Measured from a fresh clone on a 2-core CPU (2026-12-02; the machine's load is in the linked section): "
         "the install took "
         "23 s, the run with its pictures 200 s; the test command below 603 s "
-        "([The main job](docs/results.md#the-main-job))."]
+        "([The main job](docs/results/performance.md#the-main-job))."]
     FRESH["ok"] = False                      # a failed command is not quoted in the README
     try:
         with open(tmp_path / "benchmarks" / SOURCE, "w") as fh:

@@ -1,9 +1,9 @@
 """Do the field columns keep their outcome with the laminate closure at their layer interfaces?
 
 At the field protocol's 4 cells across the weak layer the grid's bimaterial artefact is at its worst (the rows
-next to the weak layer carry up to 85 % more or less than the overburden, docs/results.md, "Stress at the weak
+next to the weak layer carry up to 85 % more or less than the overburden, docs/results/snow.md, "Stress at the weak
 layer's interfaces"), and the slab-stress studies found the run's slab layers at the base 0.7 to 51 times the
-static FE's stress (docs/results.md, "A resolved slab"). The laminate closure (``scene.interface_closure``,
+static FE's stress (docs/results/field-slab.md, "A resolved slab"). The laminate closure (``scene.interface_closure``,
 docs/model.md §5b) removes that artefact in the settled column. This study draws ``--per-class`` cases of each
 observed class at random (``--seed``; blind to the predicted class) from the committed development-set batches
 (``--batches``) among those whose batch run took at most ``--max-wall`` seconds, sets each up again from its

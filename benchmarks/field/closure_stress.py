@@ -1,7 +1,7 @@
 """Is the slab's stress at the weak layer the grid's? The closure study's columns against a static FE.
 
 The slab-stress studies found a field run's slab layers next to the weak layer 0.7 to 51 times the stress of a
-static FE that resolves every layer, where the layers clear of it agree (docs/results.md, "A resolved slab").
+static FE that resolves every layer, where the layers clear of it agree (docs/results/field-slab.md, "A resolved slab").
 This study takes the SF and END cases of ``closure.py``'s draw (its JSON names them, its ``--runs`` holds their
 checkpoints) and runs each from its scenario with the laminate closure ``--closure on`` or ``off``, nothing
 else changed, with the particles' stress at every frame (``slab_stress.py``): per slab layer the largest

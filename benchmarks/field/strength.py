@@ -1,12 +1,13 @@
 """Would a weaker slab tell SF from END? The field columns run again with their slab's tensile strength scaled.
 
-The model calls 35 of the development set's 45 SF records END: their slab never cracked through (docs/results.md,
-"Field outcomes against the observers"). The static FE's slab stress ranks an SF record above an END record in 85 %
-of the pairs (docs/results.md, "A resolved slab"), so the SF slabs are the more loaded ones, but at a fraction of
-their strength (Sigrist 2006 from the density, docs/model.md §9). This sensitivity study asks whether the strength
-law is the lever: if a slab weaker by a factor ``--scale`` broke mostly in the SF records and seldom in the END
-ones, an independently measured field-scale strength would be worth taking; if it broke in both alike, the
-strength law cannot separate them. The factor is a what-if, never a calibration: no default changes.
+The model calls 35 of the development set's 45 SF records END: their slab never cracked through
+(docs/results/field.md, "Field outcomes against the observers"). The static FE's slab stress ranks an SF record
+above an END record in 85 % of the pairs (docs/results/field-slab.md, "A resolved slab"), so the SF slabs are the
+more loaded ones, but at a fraction of their strength (Sigrist 2006 from the density, docs/model.md §9). This
+sensitivity study asks whether the strength law is the lever: if a slab weaker by a factor ``--scale`` broke mostly
+in the SF records and seldom in the END ones, an independently measured field-scale strength would be worth taking;
+if it broke in both alike, the strength law cannot separate them. The factor is a what-if, never a calibration: no
+default changes.
 
 It draws the cases as ``closure.py`` does (``--per-class`` of each observed class at random, ``--seed``, among the
 committed batches' cases whose run took at most ``--max-wall`` s), sets each up again from its pit (its id's

@@ -1,4 +1,5 @@
-"""The results document, ``docs/results.md``, and the README's headline numbers, generated from the benchmarks' JSON.
+"""The results pages under ``docs/results/``, their index ``docs/results.md`` and the README's headline numbers,
+generated from the benchmarks' JSON.
 
 Run ``python -m mpm_warp.studies.report`` after a benchmark has written new results (``--check`` only says
 whether the committed files are current; ``tests/test_results_current.py`` checks it in CI). Every number
@@ -17,11 +18,13 @@ file's JSON that returns the Markdown lines of its tables and findings, register
 
 in the module of its part (:mod:`.perf`, :mod:`.convergence`, :mod:`.snow_runs`, :mod:`.snow_studies`,
 :mod:`.robustness`; the parts are :data:`.core.PARTS`, in that order, and within a part the sections appear
-in the order they are registered). Format every number with :mod:`.fmt` and put the
+in the order they are registered). A section goes on its part's page of :data:`.core.PAGES` unless it names
+another (``page="field_slab"``); :mod:`.pages` writes each page, its checks table first, and the index.
+Format every number with :mod:`.fmt` and put the
 environment note (:func:`.fmt.env_note`) under the table. A study whose JSON is not committed yet is
 registered with :func:`.core.pending` (its section says "not measured yet" until the file appears); a file
 that does not exist is always skipped with that line, so a section can be written before its first run.
-Then run the command and commit ``docs/results.md``.
+Then run the command and commit ``docs/results.md`` and ``docs/results/``.
 """
 
 from __future__ import annotations
@@ -53,11 +56,12 @@ from . import (  # noqa: F401
     snow_studies,
     snowpack,
 )
-from .core import DOC, SECTIONS, Context, document, pending, section
+from .core import DOC, PAGE_DIR, SECTIONS, Context, pending, section
+from .pages import generate
 from .readme import block, headlines, with_block
 
-__all__ = ["SECTIONS", "Context", "section", "pending", "default_root", "results_markdown", "readme_text", "headlines",
-           "main"]
+__all__ = ["SECTIONS", "Context", "section", "pending", "default_root", "results_pages", "results_markdown",
+           "readme_text", "headlines", "main"]
 
 
 def default_root() -> str:
@@ -65,9 +69,15 @@ def default_root() -> str:
     return os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 
 
+def results_pages(root: str | None = None) -> dict[str, str]:
+    """Every results file (``docs/results.md`` and its pages, relative to ``root``) -> its text, from the results
+    under ``<root>/benchmarks/``."""
+    return generate(Context(root or default_root()))
+
+
 def results_markdown(root: str | None = None) -> str:
-    """The text of ``docs/results.md`` from the results under ``<root>/benchmarks/``."""
-    return document(Context(root or default_root()))
+    """The text of ``docs/results.md``, the index of the results pages."""
+    return results_pages(root)[DOC]
 
 
 def readme_text(root: str | None = None) -> str | None:
@@ -98,8 +108,7 @@ def main(argv=None) -> int:
     ap.add_argument("--check", action="store_true", help="write nothing; exit 1 if a generated file is out of date")
     a = ap.parse_args(argv)
     root = a.root or default_root()
-    doc = os.path.join(root, DOC)
-    targets = [(doc, results_markdown(root))]
+    targets = [(os.path.join(root, rel), text) for rel, text in results_pages(root).items()]
     readme = readme_text(root)
     if readme is not None:
         targets.append((os.path.join(root, "README.md"), readme))
@@ -110,8 +119,16 @@ def main(argv=None) -> int:
             stale.append(path)
             if not a.check:
                 _write(path, text)
+    pages = os.path.join(root, PAGE_DIR)
+    stray = sorted(os.path.join(pages, f) for f in (os.listdir(pages) if os.path.isdir(pages) else [])
+                   if f.endswith(".md") and os.path.join(pages, f) not in dict(targets))
     for path in stale:
         print(("out of date: " if a.check else "wrote ") + os.path.relpath(path, root))
+    for path in stray:                                # a page no section is on any more
+        print(("not generated: " if a.check else "removed ") + os.path.relpath(path, root))
+        if not a.check:
+            os.remove(path)
+    stale += stray
     if not stale:
         print("current: " + ", ".join(os.path.relpath(p, root) for p, _ in targets))
     if readme is None:

@@ -1,4 +1,5 @@
-"""``python -m mpm_warp.studies.report``: write ``docs/results.md`` and the README's headline block."""
+"""``python -m mpm_warp.studies.report``: write ``docs/results.md``, its pages under ``docs/results/`` and the
+README's headline block."""
 
 import sys
 

@@ -1,29 +1,76 @@
-"""The results document's machinery: sections (one per result file), their registry, and the assembly.
+"""The results' machinery: sections (one per result file), their registry, their pages and one section's Markdown.
 
 A section is a function of one result file's JSON that returns the Markdown of its tables and findings;
 :func:`section` registers it with its title, its file under ``benchmarks/``, the command that reproduces
-it and its figure. :func:`document` writes every registered section in order, with a "not measured yet"
-line for a file that does not exist yet.
+it, its figure and the page it goes on (:data:`PAGES`). :func:`render_section` writes one section, with a
+"not measured yet" line for a file that does not exist yet; :mod:`.pages` assembles the pages and their index.
 """
 
 from __future__ import annotations
 
 import os
+import posixpath
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from ...errors import InvalidArgument
 from ...finite_json import load_json
-from .fmt import environment_of
 
-__all__ = ["PARTS", "Section", "Context", "SECTIONS", "section", "pending", "document", "slug"]
+__all__ = ["PARTS", "Page", "PAGES", "Section", "Context", "SECTIONS", "section", "pending", "render_section", "slug"]
 
-#: The parts of the document, in order: key -> heading.
+#: The parts of the results, in order: key -> heading.
 PARTS = {"perf": "Performance", "convergence": "Convergence", "snow": "Snow science", "field": "Field data",
          "robustness": "Robustness"}
 
+#: The index of the results, the file that links every page.
 DOC = "docs/results.md"
+#: The folder of the pages, relative to the repository.
+PAGE_DIR = "docs/results"
+
+
+@dataclass(frozen=True)
+class Page:
+    """One generated page of the results: the sections that answer one question.
+
+    Attributes
+    ----------
+    name : str
+        The file's name without ``.md``, in :data:`PAGE_DIR`.
+    title : str
+        The page's heading.
+    question : str
+        What the page answers, one line (the index shows it).
+    """
+
+    name: str
+    title: str
+    question: str
+
+    @property
+    def path(self) -> str:
+        """The page, relative to the repository (``docs/results/field.md``)."""
+        return f"{PAGE_DIR}/{self.name}.md"
+
+
+#: The pages, in order: key -> page. A section goes on the page of its part's key unless it names another.
+PAGES = {
+    "perf": Page("performance", "Performance",
+                 "How fast is a step, on a CPU beside Taichi and on a GPU, and what does each part of it cost?"),
+    "convergence": Page("convergence", "Convergence",
+                        "How does the error fall with the grid, against exact answers and the snow ladders, and at "
+                        "what run time?"),
+    "snow": Page("snow", "Snow science",
+                 "Do the model's PSTs, shear tests and crack speeds agree with weac, closed forms and field ranges?"),
+    "field": Page("field", "Field data: the scores",
+                  "How well does the model call real PSTs (END, SF, ARR), at what cost, and do the batch's set-up "
+                  "choices (base, pre-cut, grid, the END call) change the calls?"),
+    "field_slab": Page("field-slab", "Field data: why the slab does not break",
+                       "Where the observers saw the slab break (SF) and the model did not: the slab's stress against "
+                       "static models, and what-ifs on its strength, width and weak layer."),
+    "robustness": Page("robustness", "Robustness",
+                        "Does a run survive its machine's failures (a full disk), and does its resume hold?"),
+}
 
 
 @dataclass(frozen=True)
@@ -47,6 +94,8 @@ class Section:
         The committed figure, relative to ``benchmarks/``, embedded after the tables when it exists.
     question : str
         What the file answers, one line.
+    page : str or None
+        Key of :data:`PAGES` the section goes on; None: its part's.
     """
 
     part: str
@@ -56,6 +105,12 @@ class Section:
     render: Callable[[dict, Context], list[str]] | None
     figure: str | None = None
     question: str = ""
+    page: str | None = None
+
+    @property
+    def page_key(self) -> str:
+        """The key of :data:`PAGES` of the page the section is on."""
+        return self.page or self.part
 
 
 #: Every registered section, in the order of the document.
@@ -63,15 +118,17 @@ SECTIONS: list[Section] = []
 
 
 def section(part: str, title: str, source: str, command, figure: str | None = None, question: str = "",
-            follows: str | None = None):
+            follows: str | None = None, page: str | None = None):
     """Decorator registering ``render(data, ctx) -> list[str]`` as the section of ``source`` (see :class:`Section`);
     ``follows``: the title of the section this one comes right after, registered before or after it (else it
-    comes last)."""
+    comes last); ``page``: the key of :data:`PAGES` it goes on (default: its part's)."""
     if part not in PARTS:
         raise InvalidArgument("part", part, f"one of {sorted(PARTS)}")
+    if (page or part) not in PAGES:
+        raise InvalidArgument("page", page, f"one of {sorted(PAGES)}")
 
     def register(render):
-        _place(Section(part, title, source, command, render, figure, question), follows)
+        _place(Section(part, title, source, command, render, figure, question, page), follows)
         return render
     return register
 
@@ -107,12 +164,15 @@ class Context:
     ----------
     root : str
         The repository root (it holds ``benchmarks/`` and ``docs/``).
+    base : str
+        The folder, relative to the root, of the page the links are written into (default: the pages').
     """
 
-    def __init__(self, root: str):
+    def __init__(self, root: str, base: str = PAGE_DIR):
         if not os.path.isdir(os.path.join(root, "benchmarks")):
             raise InvalidArgument("root", root, "a checkout of mpm_warp, the folder holding benchmarks/")
         self.root = root
+        self.base = base
         self._cache: dict[str, dict | None] = {}
 
     def path(self, source: str) -> str:
@@ -132,11 +192,14 @@ class Context:
                 self._cache[source] = None
         return self._cache[source]
 
-    @staticmethod
-    def link(source: str, text: str | None = None, base: str = "docs") -> str:
-        """A relative Markdown link to ``benchmarks/<source>`` from a file in ``base`` (``docs`` or the root)."""
-        prefix = "../benchmarks/" if base == "docs" else "benchmarks/"
-        return f"[`{text or source}`]({prefix}{source})"
+    def url(self, source: str, base: str | None = None) -> str:
+        """The relative address of ``benchmarks/<source>`` from a file in ``base`` (a folder relative to the root,
+        ``"."`` for the root; default: :attr:`base`)."""
+        return posixpath.join(posixpath.relpath("benchmarks", base or self.base), source)
+
+    def link(self, source: str, text: str | None = None, base: str | None = None) -> str:
+        """A relative Markdown link to ``benchmarks/<source>`` from a file in ``base`` (see :meth:`url`)."""
+        return f"[`{text or source}`]({self.url(source, base)})"
 
 
 def slug(title: str) -> str:
@@ -151,8 +214,10 @@ def _command(sec: Section, data: dict | None) -> str:
     return sec.command
 
 
-def _render_section(sec: Section, ctx: Context) -> list[str]:
-    out = [f"### {sec.title}", ""]
+def render_section(sec: Section, ctx: Context, level: int = 2) -> list[str]:
+    """The Markdown lines of one section, under a heading of ``level``: its question, command, data, tables and
+    figure, or one line saying its file is not committed yet."""
+    out = [f"{'#' * level} {sec.title}", ""]
     if sec.question:
         out += [sec.question, ""]
     data = ctx.load(sec.source)
@@ -163,49 +228,11 @@ def _render_section(sec: Section, ctx: Context) -> list[str]:
         return out
     out += [f"Command: `{_command(sec, data)}`. Data: {ctx.link(sec.source)}.", ""]
     if sec.render is None:
-        out += ["The JSON is committed; its tables are not written into this document yet "
+        out += ["The JSON is committed; its tables are not written into this page yet "
                 "(a section function in `mpm_warp/studies/report/`).", ""]
         return out
     body = sec.render(data, ctx)
     out += body + ([""] if body and body[-1] != "" else [])
     if sec.figure and ctx.exists(sec.figure):
-        out += [f"![{sec.title}](../benchmarks/{sec.figure})", ""]
+        out += [f"![{sec.title}]({ctx.url(sec.figure)})", ""]
     return out
-
-
-HEAD = """# Measured results
-
-Generated by `python -m mpm_warp.studies.report` from the committed JSON under `benchmarks/<group>/results/`:
-do not edit it by hand; rerun the command after a benchmark has written new results
-(`tests/test_results_current.py` fails while this file is out of date). Each table gives the command
-that reproduces it, the JSON it comes from and, under it, where and when it was measured. What each
-script asks and how long it runs is in [`benchmarks/README.md`](../benchmarks/README.md).
-"""
-
-
-def document(ctx: Context, sections: list[Section] | None = None) -> str:
-    """The whole results document (Markdown) from the registered sections (or ``sections``)."""
-    if _WAITING:
-        raise InvalidArgument("follows", sorted(_WAITING), "titles of registered sections")
-    sections = SECTIONS if sections is None else sections
-    out = [HEAD]
-    devices = sorted({str(environment_of(ctx.load(s.source))["device"] or "")
-                      for s in sections if ctx.load(s.source) is not None} - {""})
-    if devices:
-        out += [f"Devices of the committed results: {', '.join(devices)}.", ""]
-    toc = []
-    for key, heading in PARTS.items():
-        mine = [s for s in sections if s.part == key]
-        if mine:
-            toc.append(f"- [{heading}](#{slug(heading)}): "
-                       + ", ".join(f"[{s.title}](#{slug(s.title)})" for s in mine))
-    out += toc + [""]
-    for key, heading in PARTS.items():
-        mine = [s for s in sections if s.part == key]
-        if not mine:
-            continue
-        out += [f"## {heading}", ""]
-        for s in mine:
-            out += _render_section(s, ctx)
-    text = "\n".join(out)
-    return text.rstrip("\n") + "\n"

@@ -7,6 +7,7 @@ from statistics import median
 from .convergence import field_level_errors
 from .core import section
 from .fmt import count, env_note, fx, pct, secs, spct, table
+from .pages import ref
 
 #: the share of End/SF/Arr records that must become runnable columns (issue: real pits in)
 TARGET = 0.80
@@ -175,7 +176,7 @@ def _resolution(data: dict, ctx) -> list[str]:
     lv = (ladder.get("field_level") or {}).get("record", {})
     if errs and want is not None and round(lv.get("cells_across_layer", -1)) == want:
         said = (f"On the snow ladder's PST at {want} cells (a 30 cm slab on a 6 cm layer, dx {fx(lv['dx'], 0, 1e3)} "
-                "mm; docs/results.md, \"Error against run time: the snow ladders\"), the error against the ladder's "
+                f"mm; {ref('Error against run time: the snow ladders')}), the error against the ladder's "
                 f"reference: {'; '.join(errs)}. A field column's layer is thinner, so its slab has more cells "
                 "than the ladder's at the same cells across the layer.")
     else:
@@ -185,8 +186,8 @@ def _resolution(data: dict, ctx) -> list[str]:
     if res and res.get("cases"):
         same = sum(c["coarse"]["predicted"] == c["fine"]["predicted"] for c in res["cases"])
         said += (f" On field columns themselves, {same} of {len(res['cases'])} drawn cases kept their class at "
-                 f"{res['cells'][1]} cells across the weak layer (docs/results.md, \"The grid: the same columns at "
-                 f"{res['cells'][1]} cells across the weak layer\").")
+                 f"{res['cells'][1]} cells across the weak layer "
+                 f"({ref('The grid: the same columns at 6 cells across the weak layer')}).")
     return ["", f"- **Resolution:** cells across the weak layer: {used}{budget}. " + said]
 
 

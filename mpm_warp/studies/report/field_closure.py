@@ -32,7 +32,7 @@ def _balanced(cases: list, side: str) -> tuple[float | None, dict]:
          question="Does a field case keep its class, and its runaway cut, when its column runs with the laminate "
                   "closure at its layer interfaces (docs/model.md §5b), which removes the grid's bimaterial artefact "
                   "at the weak layer?",
-         follows="A resolved slab: the run and weac against a static FE")
+         follows="A resolved slab: the run and weac against a static FE", page="field_slab")
 def render_closure(data: dict, ctx) -> list[str]:
     cases = data["cases"]
     rows = []
@@ -113,7 +113,7 @@ def _layers(v: list | None) -> str:
                    "closure.py's runs",
          question="Is the slab's stress next to the weak layer, far above a static FE's in the field runs, the "
                   "grid's bimaterial artefact that the closure removes?",
-         follows="The laminate closure: the same columns without and with it")
+         follows="The laminate closure: the same columns without and with it", page="field_slab")
 def render_closure_stress(data: dict, ctx) -> list[str]:
     from .field_slab_fe import AGREE, SMALL, _at_base, _auc
 

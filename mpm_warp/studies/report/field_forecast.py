@@ -21,7 +21,7 @@ def _iv(iv, nd: int = 2) -> str:
          question="The observers' SF slabs are thin and light. Which quantity of the column, from the records, the "
                   "run, weac or a closed form of published laws, tells their SF records from their END records, and "
                   "how well? Nothing is fitted.",
-         follows="The weak layer's stiffness: the same columns on a softer weak layer")
+         follows="The weak layer's stiffness: the same columns on a softer weak layer", page="field_slab")
 def render_mechanisms(data: dict, ctx) -> list[str]:
     c = data["candidates"]
     rows = [[f"`{k}`", v["what"], v["direction"], fx(v["sf_vs_end"]["auc"], 3), fx(v["arr_vs_rest"]["auc"], 3),

@@ -42,7 +42,7 @@ def _row(cases: list, cls: str) -> list[str]:
          question="The run and weac take a PST column as infinitely wide across the slope (plane strain); a field "
                   "column is 30 cm wide with free side walls. Does the slab's stress where the crack started change "
                   "between plane strain and plane stress, the two limits such a column lies between?",
-         follows="The far end: the columns called END, run on past the call")
+         follows="The far end: the columns called END, run on past the call", page="field_slab")
 def render_plane_stress(data: dict, ctx) -> list[str]:
     cases = data["cases"]
     out = [f"Cases: every case the committed development-set batches scored ({len(cases)}), set up again from its "

@@ -8,7 +8,8 @@ from .core import section
 from .fmt import check_line, count, env_note, fx, spct, table
 
 #: the runaway cut may move by this share (-) between the bases: twice the critical cut's error the snow ladder
-#: states at 6 cells across the weak layer (5.6 %, docs/results.md "Error against run time: the snow ladders")
+#: states at 6 cells across the weak layer (5.6 %, docs/results/convergence.md "Error against run time: the snow
+#: ladders")
 CUT_SHARE = 0.10
 
 

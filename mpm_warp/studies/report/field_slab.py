@@ -84,7 +84,8 @@ def _command(d: dict, out: str = "") -> str:
 @section("field", "Why the slab did not break", "field/results/field_slab_stress.json",
          _command,
          question="Where the observer saw the slab break (SF) and the model did not, how close did the run's slab "
-                  "come to its tensile strength, and what does weac's static beam say at the same cut?")
+                  "come to its tensile strength, and what does weac's static beam say at the same cut?",
+         page="field_slab")
 def render_slab_stress(data: dict, ctx) -> list[str]:
     cases = data["cases"]
     where = any(c.get("peak_at") for c in cases)
@@ -151,7 +152,8 @@ def ranked_above(high: list, low: list) -> float:
 @section("field", "The slab's stress where the observer saw END", "field/results/end/field_slab_stress.json",
          lambda d: _command(d, "benchmarks/field/results/end"),
          question="Beside the SF records: how close does the run's slab come to its strength in END records the "
-                  "model also called END? (A slab stress that tells SF from END would come closer in SF records.)")
+                  "model also called END? (A slab stress that tells SF from END would come closer in SF records.)",
+         page="field_slab")
 def render_end(data: dict, ctx) -> list[str]:
     """:func:`render_slab_stress`, and how well the run's peak slab stress ranks the SF records above these."""
     out = render_slab_stress(data, ctx)

@@ -87,7 +87,7 @@ def _off(pairs) -> list[float]:
 @section("field", "A resolved slab: the run and weac against a static FE", "field/results/field_slab_fe.json",
          lambda d: "python benchmarks/field/slab_fe.py RUNDIR1 RUNDIR2  # the runs of the slab-stress studies",
          question="Is a field run's slab stress, or weac's, nearer a continuum that resolves every layer? The "
-                  "columns of the two slab-stress studies, solved statically at the crack's onset.")
+                  "columns of the two slab-stress studies, solved statically at the crack's onset.", page="field_slab")
 def render_slab_fe(data: dict, ctx) -> list[str]:
     cases = [c for c in data["cases"] if c.get("at_onset")]
     mm = " and ".join(f"{fx(m * 1e3, 0)} mm" for m in data["meshes_m"])

@@ -104,7 +104,7 @@ def _summary(data: dict) -> list:
                    f"--workers {d['workers']} --threads {d['threads']} --out benchmarks/{os.path.dirname(MAIN)}",
          question="Is the slab's tensile strength the lever that would tell SF from END? The same columns, every slab "
                   "layer's strength scaled by a what-if factor (not a calibration: no default changes).",
-         follows="The laminate closure: the slab's stress at the weak layer against the FE")
+         follows="The laminate closure: the slab's stress at the weak layer against the FE", page="field_slab")
 def render_strength(data: dict, ctx) -> list[str]:
     s = data["scale"]
     cases = data["cases"]
@@ -181,7 +181,7 @@ def _static_balanced(cases: list, key: str) -> tuple[float, dict]:
          question="Does the grain form of the slab's snow tell SF from END? Faceted snow is about half as strong in "
                   "tension as rounded snow of the same density in situ (Jamieson and Johnston 1990), which the "
                   "density law leaves out.",
-         follows="The slab's strength: the same columns with a weaker slab")
+         follows="The slab's strength: the same columns with a weaker slab", page="field_slab")
 def render_static_strength(data: dict, ctx) -> list[str]:
     cases = [c for c in data["cases"] if c["static_law"] is not None]
     f = data["faceted"]

@@ -34,7 +34,7 @@ def _why(line: str) -> str:
          question="A pit records no stiffness, and every field column's weak layer has the scene's modulus, the top of "
                   "the field's range. Would a softer weak layer tell the outcomes apart? The same columns set up "
                   "again on a softer layer (a what-if, not a calibration: no default changes).",
-         follows="Plane strain against a 30 cm wide column: the slab's stress at the recorded cut")
+         follows="Plane strain against a 30 cm wide column: the slab's stress at the recorded cut", page="field_slab")
 def render_weak_modulus(data: dict, ctx) -> list[str]:
     e0, e1 = data["scene_modulus_mpa"], data["modulus_mpa"]
     cases = data["cases"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from .core import Context, section
 from .fmt import count, env_note, environment_of, finite, fx, secs, table
+from .pages import ref
 
 __all__ = ["BEGIN", "END", "SOURCE", "main_job_block"]
 
@@ -64,4 +65,4 @@ def main_job_block(ctx: Context) -> list[str] | None:
             f"took {secs(install)}, the run with its pictures {secs(run['wall_s'])}")
     if tests:
         line += f"; the test command below {secs(tests)}"
-    return [line + f" ([{TITLE}](docs/results.md#the-main-job))."]
+    return [line + f" ({ref(TITLE, '.')})."]

@@ -8,21 +8,24 @@ from __future__ import annotations
 
 from ... import markers
 from ..snow import DEM_STEADY_MAX, FIELD_SPEED, LONG_PST_SPEED, STEADY_FROM
-from .core import Context, slug
+from .core import PAGES, Context, slug
 from .fmt import bracket, finite, fx, ratio_range, spct
+from .pages import page_of
 from .snow_runs import steady_speed
 
 __all__ = ["BEGIN", "END", "headlines", "block", "with_block"]
 
 BEGIN = "<!-- results:begin -->"
 END = "<!-- results:end -->"
-#: The block's last line, after the bullets.
-WHERE = ("Every measured table, with the command that reproduces it and where it was measured, is in "
-         "[docs/results.md](docs/results.md).")
+#: The block's last line, after the bullets: the results pages, by question.
+WHERE = ("Every measured table, with the command that reproduces it and where it was measured, is in the results "
+         "pages, each opening with its checks: " + ", ".join(f"[{p.title}]({p.path})" for p in PAGES.values())
+         + " (the index: [docs/results.md](docs/results.md)).")
 
 
 def _link(title: str) -> str:
-    return f"docs/results.md#{slug(title)}"
+    """The README's address of the section ``title``: its page's, with its anchor."""
+    return f"{page_of(title) or 'docs/results.md'}#{slug(title)}"
 
 
 def _throughput(ctx: Context, source: str, dim: int, title: str) -> str | None:

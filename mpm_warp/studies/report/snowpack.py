@@ -65,7 +65,7 @@ def render_outcomes(data: dict, ctx) -> list[str]:
     for name, c in cases.items():
         png = f"snow/results/{c['picture']}"
         if ctx.exists(png):
-            out += ["", f"![{name}: {c['outcome']['field_line']}](../benchmarks/{png})"]
+            out += ["", f"![{name}: {c['outcome']['field_line']}]({ctx.url(png)})"]
     return out
 
 
