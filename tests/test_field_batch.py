@@ -91,6 +91,16 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     with open(os.path.join(out, "refused.csv")) as fh:
         assert "slope_deg is empty" in fh.read()
     assert os.path.getsize(os.path.join(out, "confusion.png")) > 0
+    # a finished case run on past its call, on a copy: the batch's files stay as they were
+    from mpm_warp.field.run_on import run_on
+
+    case = again.records[1]
+    run_file = os.path.join(out, case["id"] + ".h5")
+    before = os.stat(run_file).st_mtime_ns
+    went = run_on(out, case["id"], str(tmp_path / "on"), after=0.01)
+    assert os.stat(run_file).st_mtime_ns == before
+    assert went["sim_time_after"] == pytest.approx(0.01, abs=0.006)       # to the frame at or past 0.01 s
+    assert went["peak_stress_ratio_before"] == pytest.approx(case["slab_peak_stress_ratio"])
 
 
 def test_bad_batch_arguments_are_one_line(tmp_path, capsys):

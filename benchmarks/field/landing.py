@@ -1,0 +1,113 @@
+"""Does the model's slab break once it lands, after the crack has reached the end, and more often in SF records?
+
+The batch stops a case at its END call; an observer watches the cut slab fall onto its collapsed weak layer.
+For every finished case of a field batch's runs folder that the batch called END, a copy of its run is resumed
+from its checkpoint for ``--after`` seconds more (``mpm_warp.field.run_on``; the batch's files are not written),
+stopping at a crack through the slab. Per case: whether and when the slab cracked through, its peak stress over
+strength before and after the call, the longest touchdown distance the run measured, and Heierli's touchdown
+distance against the column (``mpm_warp.field.mechanisms``). Summed by observed class, with the SF-against-END
+AUC of the peak stress after the call and of a through-crack. A case's record is kept in ``--work`` (a rerun
+resumes). Writes ``benchmarks/field/results/field_landing.json``.
+
+Usage: ``python benchmarks/field/landing.py --runs RUNDIR --work DIR [--after 0.1]``; ``--quick``: one case.
+"""
+
+from __future__ import annotations
+
+import glob
+import json
+import os
+import sys
+import warnings
+
+from mpm_warp.field.mechanisms import touchdown_distance
+from mpm_warp.field.run_on import run_on
+from mpm_warp.field.scores import FIELD_CLASSES
+from mpm_warp.io.records import write_record
+from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.protocol import out_dir, parser
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+
+
+def scene_of(run_dir: str, case_id: str):
+    """The PST parameters a case ran (from its checkpoint)."""
+    from mpm_warp.io.checkpoint import read_checkpoint_meta
+    from mpm_warp.loader import resolved_scenario
+
+    ck = os.path.join(run_dir, case_id + ".ckpt.h5")
+    return resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck).scene
+
+
+def one(rec: dict, run_dir: str, work: str, after: float) -> dict:
+    """The landing record of the batch record ``rec`` (kept in ``work``; read back when there)."""
+    path = os.path.join(work, rec["id"] + ".landing.json")
+    if os.path.exists(path):
+        with open(path) as fh:
+            return json.load(fh)
+    p = scene_of(run_dir, rec["id"])
+    out = {k: rec.get(k) for k in ("id", "test", "observed", "predicted", "slab_depth", "slab_density")}
+    out.update(touchdown_distance=touchdown_distance(p), column_m=float(p.length))
+    try:
+        out.update(status="ok", **run_on(run_dir, rec["id"], work, after))
+    except Exception as e:      # recorded, never stops the others
+        out.update(status="failed", error=f"{type(e).__name__}: {e}")
+    write_record(path, out, "a landing record", default=str)
+    for f in (rec["id"] + ".h5", rec["id"] + ".ckpt.h5"):      # the copy has served: keep the record only
+        if os.path.exists(os.path.join(work, f)):
+            os.remove(os.path.join(work, f))
+    return out
+
+
+def summary(rows: list[dict]) -> dict:
+    """Per observed class: cases, through-cracks after the call, median peak stress ratio after it; and the AUCs."""
+    from sklearn.metrics import roc_auc_score
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    by = {}
+    for c in FIELD_CLASSES:
+        of = [r for r in ok if r["observed"] == c]
+        after = sorted(r["peak_stress_ratio_after"] for r in of if r["peak_stress_ratio_after"] is not None)
+        inside = [r for r in of if r["touchdown_distance"] < r["column_m"]]
+        by[c] = {"cases": len(of), "through_crack": sum(r["slab_through_crack_time"] is not None for r in of),
+                 "touchdown_inside": len(inside),
+                 "through_crack_touchdown_inside": sum(r["slab_through_crack_time"] is not None for r in inside),
+                 "median_peak_after": after[len(after) // 2] if after else None}
+    se = [r for r in ok if r["observed"] in ("SF", "END") and r["peak_stress_ratio_after"] is not None]
+    y = [r["observed"] == "SF" for r in se]
+    two = 0 < sum(y) < len(y)
+    return {"by_observed": by,
+            "auc_peak_after": float(roc_auc_score(y, [r["peak_stress_ratio_after"] for r in se])) if two else None,
+            "auc_through_crack": float(roc_auc_score(y, [r["slab_through_crack_time"] is not None for r in se]))
+            if two else None, "sf_end_cases": len(se)}
+
+
+def main(argv=None) -> int:
+    p = parser(__doc__, "one case")
+    p.add_argument("--runs", required=True, help="a field batch's runs folder (field_batch.py --runs)")
+    p.add_argument("--work", required=True, help="folder of the copies and the per-case records (kept: resumes)")
+    p.add_argument("--after", type=float, default=0.1, help="simulated time past the END call (s, default 0.1)")
+    args = p.parse_args(argv)
+    warnings.filterwarnings("ignore")
+    recs = []
+    for f in sorted(glob.glob(os.path.join(args.runs, "*.json"))):
+        with open(f) as fh:
+            r = json.load(fh)
+        if r.get("status") == "ok" and r.get("predicted") == "END" and r.get("observed"):
+            recs.append(r)
+    recs = recs[:1] if args.quick else recs
+    rows = []
+    for r in recs:
+        rows.append(one(r, args.runs, args.work, args.after))
+        x = rows[-1]
+        print(f"{x['test']} ({x['observed']}): through-crack {x.get('slab_through_crack_time')}, peak after "
+              f"{x.get('peak_stress_ratio_after')}", flush=True)
+    data = {"name": "field_landing", "runs": os.path.basename(os.path.normpath(args.runs)), "after_s": args.after,
+            "environment": environment("cpu"), "summary": summary(rows), "cases": rows}
+    path = write_json("field_landing", data, out_dir(args, RESULTS, "field_landing"))
+    print(f"{path}: {len(rows)} cases")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
