@@ -186,3 +186,26 @@ def test_the_run_summary_line_of_the_probabilities():
     assert line.startswith("  P(END) 0.74, P(SF) 0.26, P(ARR) 0.00 (the slab's peak stress 0.50 x its strength")
     assert probability_line({"class": None, "slab_peak_stress_ratio": 0.5}) == ""
     assert probability_line({"class": "END"}) == ""                      # a slab that cannot break
+
+
+def test_touchdown_distance_and_brittleness_of_a_homogeneous_slab_by_hand():
+    """One layer: the bending stiffness E' h^3 / 12 about its middle, Heierli's 2.331 (2 h_f D / q)^(1/4) with
+    weac's collapse height of the weak layer; the brittleness h sigma_t^2 / (K_Ic^2 (1 - nu^2))."""
+    from mpm_warp.field.mechanisms import brittleness, slab_bending_stiffness, touchdown_distance
+    from mpm_warp.scenes.density_laws import fracture_toughness, sigrist_tensile_strength
+    from mpm_warp.scenes.pst import PSTParams
+    from mpm_warp.scenes.references import weac_collapse_height
+    from mpm_warp.scenes.snowpack import SnowLayer
+
+    p = PSTParams(slab_layers=(SnowLayer(0.3, 150.0, 1.0e6, 0.25),), slope_angle=30.0)
+    D = 1.0e6 / (1 - 0.25**2) * 0.3**3 / 12
+    assert slab_bending_stiffness(p) == pytest.approx(D, rel=1e-12)
+    # two identical halves bend as the whole
+    halves = PSTParams(slab_layers=(SnowLayer(0.1, 150.0, 1.0e6, 0.25), SnowLayer(0.2, 150.0, 1.0e6, 0.25)),
+                       slope_angle=30.0)
+    assert slab_bending_stiffness(halves) == pytest.approx(D, rel=1e-12)
+    q = 150.0 * 0.3 * 9.81 * math.cos(math.radians(30.0))
+    h_f = weac_collapse_height(p.weak_layer_thickness)
+    assert touchdown_distance(p) == pytest.approx(2.331 * (2 * h_f * D / q) ** 0.25, rel=1e-12)
+    want = 0.3 * sigrist_tensile_strength(150.0) ** 2 / (fracture_toughness(150.0) ** 2 * (1 - 0.25**2))
+    assert brittleness(p) == pytest.approx(want, rel=1e-12)
