@@ -111,3 +111,31 @@ def render_forecast(data: dict, ctx) -> list[str]:
                            + ("" if complete else "; the draw is not complete"))]
     out += ["", env_note(data)]
     return out
+
+
+@section("field", "The landing: the columns called END, run on as the slab lands", "field/results/field_landing.json",
+         lambda d: f"python benchmarks/field/landing.py --runs RUNDIR --work DIR --after {d['after_s']:g}",
+         question="The batch stops a case once it calls END; the cut slab then falls onto its collapsed weak layer "
+                  "in front of the observer. Does the model's slab break as it lands, and more often where the "
+                  "observer wrote SF?",
+         follows="Why thin, light slabs break: each candidate mechanism against the records", page="field_slab")
+def render_landing(data: dict, ctx) -> list[str]:
+    s = data["summary"]
+    by = s["by_observed"]
+    rows = [[c, str(v["cases"]), str(v["through_crack"]), str(v["touchdown_inside"]),
+             str(v["through_crack_touchdown_inside"]), fx(v["median_peak_after"], 1)] for c, v in by.items()]
+    ok = [c for c in data["cases"] if c["status"] == "ok"]
+    out = [f"The {len(data['cases'])} cases of the batch `{data['runs']}` called END whose runs had finished, each "
+           f"resumed on a copy for {fx(data['after_s'], 2)} s past its call, stopping at a crack through the slab "
+           "(the batch's own detector). Touchdown inside: Heierli's touchdown distance shorter than the column.", ""]
+    out += table(["observed", "cases", "slab cracked through", "touchdown inside the column",
+                  "of those, cracked through", "median peak stress over strength after the call"], rows)
+    through = sum(v["through_crack"] for v in by.values())
+    above = sum(c["peak_stress_ratio_after"] is not None and c["peak_stress_ratio_after"] >= 1.0 for c in ok)
+    out += ["", f"- {through} of {len(ok)} slabs cracked through within {fx(data['after_s'], 2)} s of the call; "
+            f"{above} of {len(ok)} reached their strength somewhere after it. The peak stress over strength after the "
+            f"call tells SF from END with an AUC of {fx(s['auc_peak_after'], 2)} ({s['sf_end_cases']} SF and END "
+            "records)."
+            + (" In the model, the landing damages the slab without breaking it through, in every class." if
+               through == 0 and above else ""), "", env_note(data)]
+    return out
