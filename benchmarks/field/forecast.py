@@ -49,7 +49,7 @@ def reliability_figure(sc: dict, path: str) -> None:
                 ax.plot(f, o, marker="o", label=f"{name} (RPSS {sc['forecast'][name]['rpss']:+.2f})")
                 for fx, ox, nx in pts:
                     ax.annotate(str(nx), (fx, ox), textcoords="offset points", xytext=(3, 3), fontsize=7)
-        ax.set(title=f"{cls}", xlabel=f"forecast P({cls})", xlim=(0, 1), ylim=(0, 1))
+        ax.set(title=f"{cls}", xlabel=f"forecast P({cls})", xlim=(-0.03, 1.03), ylim=(-0.03, 1.03))
     axes[0].set_ylabel("observed frequency (numbers: cases in the bin)")
     axes[0].legend(fontsize=7, loc="upper left")
     fig.suptitle(f"Reliability of the outcome forecasts on {sc['cases']} field PSTs")
