@@ -14,6 +14,7 @@ import pytest
 from mpm_warp.errors import MPMError
 from mpm_warp.extras import COMMAND_EXTRA, CORE, EXTRAS, extra_for, missing_line, missing_module, require
 from mpm_warp.scenes import weac_reference as wr
+from mpm_warp.studies.fresh_clone import FIELD_TABLE, plain_field_verdict
 
 try:
     import tomllib
@@ -21,8 +22,6 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CSV = ("id,outcome,slope_deg,column_cm,cut_cm,slab_cm,slab_density,weak_layer_cm,weak_layer_density,w_f,column_ends\n"
-       "tiny-a,End,0,40,12,15,180,4,,0.3,\n")
 CAAML = os.path.join(ROOT, "scenarios", "profiles", "example_pst.caaml")
 SNOWPILOT = os.path.join(ROOT, "tests", "data", "snowpilot", "snowpits-17459-caaml.xml")
 # runs mpm-warp with the top-level modules in argv[1] hidden, as on an install without them
@@ -121,7 +120,7 @@ def inputs(tmp_path_factory):
     from test_render import make_pst
 
     d = tmp_path_factory.mktemp("extras")
-    (d / "psts.csv").write_text(CSV)
+    (d / "psts.csv").write_text(FIELD_TABLE)
     return {"CSV": str(d / "psts.csv"), "RUN": make_pst(d / "pst.h5", n_frames=2), "OUT": str(d / "out")}
 
 
@@ -152,3 +151,12 @@ def test_a_command_without_its_package_says_so_in_one_line(inputs, argv, hidden,
     assert "Traceback" not in p.stderr + p.stdout
     assert lines == [missing_line(argv[0], hidden)], p.stderr
     assert f"'{hidden}' package" in lines[0] and install in lines[0]
+    if argv[0] == "field":                           # what the fresh clone's plain install must say
+        assert plain_field_verdict(p.returncode, p.stderr) == {"rc": 2, "stderr": lines, "ok": True}
+
+
+def test_the_fresh_clone_verdict_on_the_field_command():
+    line = missing_line("field", "dask")
+    assert plain_field_verdict(2, f"Warp CUDA warning: no driver\n{line}\n")["ok"]
+    assert not plain_field_verdict(1, f"Traceback (most recent call last):\n{line}\n")["ok"]
+    assert not plain_field_verdict(2, "mpm-warp: error: INPUT = 'x' is invalid\n")["ok"]     # names no extra
