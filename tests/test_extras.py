@@ -106,6 +106,7 @@ def test_weac_missing_and_weac_of_another_api_are_told_apart(monkeypatch):
     assert missing_module(e.value) is None          # the CLI prints the version line itself
 
 
+@pytest.mark.slow
 def test_require_imports_a_commands_extra(monkeypatch):
     require("run")                                  # no extra, nothing imported
     require("field")
@@ -142,7 +143,12 @@ CASES = [  # command line, hidden module, the extra (or the distribution) the li
 ]
 
 
-@pytest.mark.parametrize("argv, hidden, install", CASES, ids=[f"{c[0][0]}-{c[1]}" for c in CASES])
+# the quick tier keeps the case (field on an install without Dask); the others are slow (2-10 s each)
+PARAMS = [pytest.param(*c, id=f"{c[0][0]}-{c[1]}",
+                       marks=() if (c[0][0], c[1]) == ("field", "distributed") else pytest.mark.slow) for c in CASES]
+
+
+@pytest.mark.parametrize("argv, hidden, install", PARAMS)
 def test_a_command_without_its_package_says_so_in_one_line(inputs, argv, hidden, install):
     argv = [inputs.get(a, a) for a in argv]
     p = subprocess.run([sys.executable, "-c", BLOCKED, hidden, *argv], capture_output=True, text=True, timeout=300)
