@@ -108,6 +108,7 @@ def test_sweep_equals_runs_made_one_by_one(scheduler, tmp_path):
         assert rec["status"] == "ok" and rec["result"]["steps"] == ref.steps and rec["n_frames"] == 3
 
 
+@pytest.mark.slow
 def test_failed_case_reported_others_complete(scheduler, tmp_path):
     cases = tmp_path / "cases.csv"
     cases.write_text("materials.snow.E,materials.snow.nu\n1e6,\n2e6,\n1e6,0.7\n3e6,0.25\n")
