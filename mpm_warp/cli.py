@@ -2,7 +2,8 @@
 
 Errors the library raises on purpose (bad input, blow-ups) are printed as one
 clear line with exit status 2 (input, files) or 3 (simulation), never a traceback;
-so is any other OSError (a file system refusing a write).
+so is any other OSError (a file system refusing a write), and a missing optional package
+(its name and the extra that installs it, :mod:`mpm_warp.extras`).
 The commands call the library: :func:`mpm_warp.run`, :func:`mpm_warp.resume`,
 :func:`mpm_warp.post.render.render_run`, :func:`mpm_warp.post.plots.plot_run`,
 :func:`mpm_warp.sweep.run_sweep`.
@@ -20,6 +21,7 @@ import sys
 import time
 
 from .errors import MPMError, SimulationBlowUp
+from .extras import missing_line, missing_module, require
 from .stop import Interrupted, StopRequest  # noqa: F401 (Interrupted: part of the CLI's interface)
 
 __all__ = ["main"]
@@ -372,12 +374,16 @@ def main(argv=None) -> int:
         log.addHandler(_StderrLines())
         log.propagate = False
     try:
+        require(args.command)
         return args.func(args)
     except SimulationBlowUp as e:
         print(f"mpm-warp: {e}", file=sys.stderr)
         return 3
-    except MPMError as e:
-        print(f"mpm-warp: error: {e}", file=sys.stderr)
+    except (MPMError, ModuleNotFoundError) as e:      # a missing optional package: its name and its extra
+        module = missing_module(e)
+        if module is None and not isinstance(e, MPMError):
+            raise
+        print(missing_line(args.command, module) if module else f"mpm-warp: error: {e}", file=sys.stderr)
         return 2
     except OSError as e:                 # a file system refusing something the checks could not foresee
         print(f"mpm-warp: error: {e}", file=sys.stderr)

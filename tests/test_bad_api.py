@@ -73,6 +73,7 @@ def test_simulation_run_arguments(scenario, tmp_path, kwargs, field, needle):
     assert list(tmp_path.iterdir()) == [] and sim.time == 0.0
 
 
+@pytest.mark.slow
 def test_a_second_run_continues_or_is_refused(scenario, tmp_path):
     """After a first run to 0.01 s: a second run without output continues from there (never 0 steps in silence);
     one with an output, or one that would end where the first stopped, is refused by name and writes nothing."""

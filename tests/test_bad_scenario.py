@@ -11,6 +11,7 @@ from helpers_bad_input import BASE, MATERIALS_TABLE, TIME_TABLE, expect, load_sc
 import mpm_warp as mw
 
 
+@pytest.mark.slow
 def test_base_scene_is_valid(tmp_path):
     sc = load_scenario_text(tmp_path, BASE)
     assert sc.domain.dx == 0.02 and sc.materials["snow"].E == 1.0e6

@@ -121,6 +121,7 @@ QUICK = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rel", sorted(QUICK))
 def test_quick_mode_writes_its_json_with_the_environment_elsewhere(rel, tmp_path):
     extra, files = QUICK[rel]

@@ -210,6 +210,7 @@ def reference_return(p_tr, q_tr, L_n, k_n, c):
     return p, q, L_n + (p - p_tr) / K, k_n + work(p, q)
 
 
+@pytest.mark.slow
 def test_float64_matches_independent_reference():
     """Snow-like ranges (xi 0.002-0.5, no material snap-back): the returned state agrees to rounding."""
     n = 300

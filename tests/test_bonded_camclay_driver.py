@@ -69,6 +69,7 @@ def _isochoric_critical_state(E, nu, beta_e, xi, p0_ini, with_state=False):
     return (K * (lo - L0), lo) if with_state else K * (lo - L0)
 
 
+@pytest.mark.slow
 def test_issue_case_explicit_camclay_cycles():
     """The case is hard: camclay's explicit hardening cycles between two states at dgamma = 0.02.
 

@@ -229,6 +229,7 @@ def _random_rotation(rng):
     return q if np.linalg.det(q) > 0 else -q
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dtype,tol", [("float32", 1e-3), ("float64", 1e-11)])
 def test_objectivity_through_driver(dtype, tol):
     rng = np.random.default_rng(7)

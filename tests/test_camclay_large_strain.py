@@ -38,6 +38,8 @@ from helpers_camclay import TYPES, run_return
 import mpm_warp as mw
 from mpm_warp.material_point import drive_material_points, lame_parameters
 
+pytestmark = pytest.mark.slow
+
 TOL_UNITS = 32.0
 TOL_ANGLE_RETURN_U = 64.0
 

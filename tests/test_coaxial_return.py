@@ -144,6 +144,7 @@ def _assert_agree(free, eig, ref, inputs, material, precision, which):
     return e_free
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("precision", ["float32", "float64"])
 @pytest.mark.parametrize("material", [SNOW, LAYER], ids=["camclay", "bonded"])

@@ -83,6 +83,7 @@ def test_weak_layer_on_its_base_is_confined_along_the_bed(plane, confinement):
     assert np.max(np.abs(ratio - confinement)) < 5e-3 * confinement
 
 
+@pytest.mark.slow
 def test_sawn_slab_converges_under_refinement():
     """The peak surface stress of 20 cm of 120 kg/m^3 sawn 0.3 m on a 1 MPa weak layer, 2 m column: 1.42 kPa,
     the same to 0.2 % on 1 cm and 5 mm elements, 2.5 cm past the tip on the bedded side. A cantilever clamped at
@@ -108,6 +109,7 @@ def test_bad_input_names_the_argument(kwargs, field):
         solve_column(LAYERED, WEAK, 2.0, cut, **args)
 
 
+@pytest.mark.slow
 def test_plumb_ends_on_a_slope_follow_weac():
     """50 cm of 250 kg/m^3 (5 MPa) on a 35 deg slope, 2 m column, sawn 0.6 m: the slab's peak surface stress.
     weac 2.6 (its pst and vpst systems) gives 3.50 / 5.98 kPa for slope-normal / plumb ends cut from upslope and

@@ -36,6 +36,7 @@ def _sheared_block(dim: int, material, precision: str, dt: float) -> mw.Scenario
         precision=precision)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("precision", ["float32", "float64"])
 @pytest.mark.parametrize("model", ["elastic", "camclay"])
@@ -146,6 +147,7 @@ def test_driver_takes_initial_states_and_reports_trial_strains():
 WL = mw.BondedCamClay(1.0e6, 0.3, 150.0, M=1.2, beta=0.3, xi=0.01, p_bond=1500.0, kappa_s=20.0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("precision", ["float32", "float64"])
 def test_driver_is_the_engine_update_for_the_bonded_layer(dim, precision):

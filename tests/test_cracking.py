@@ -28,6 +28,7 @@ def uniaxial_tension(mat, eps_max, n=400, dtype="float64", rotation=None):
                                  stress_control={"axes": (False, True, True), "sigma": (0.0, 0.0, 0.0)})
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dtype", ["float64", "float32"])
 def test_uniaxial_tension_softens_linearly_and_spends_the_fracture_energy(dtype):
     mat = cracking()
@@ -92,6 +93,7 @@ def test_below_its_strength_a_cracking_slab_is_the_elastic_slab_bit_for_bit():
         assert np.all(a["kappa"] == 0.0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dim", [2, 3])
 def test_engine_block_below_its_strength_matches_the_elastic_block(dim):
     def block(mat):
@@ -122,6 +124,7 @@ def test_a_band_wider_than_the_snap_back_limit_is_refused():
         cracking(tensile_strength=0.0).validate()
 
 
+@pytest.mark.slow
 def test_plane_strain_softens_the_in_plane_stress_as_3d_does():
     # stretch along x with y stress-free and z fixed: the 2D kernels against the 3D ones (the out-of-plane stress
     # tau_zz = lam tr(eps) is not softened in 2D, where it does not act on the grid; the in-plane path is the same)

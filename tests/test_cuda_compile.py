@@ -78,6 +78,7 @@ def compiled(tmp_path_factory):
         return json.load(fh)
 
 
+@pytest.mark.slow
 def test_every_case_ran_and_launched_its_kernels(compiled):
     runs, modules = compiled["cases"], compiled["modules"]
     assert list(runs) == [c.name for c in CASES] and len(CASES) == 2 * (6 + 4 * 3 + 2 + 2 + 2 + 2 * len(DRIVER_MODELS))
@@ -103,6 +104,7 @@ def test_every_case_ran_and_launched_its_kernels(compiled):
     assert by_family["p2g_kernel"] == 2 * 2 * 6
 
 
+@pytest.mark.slow
 def test_every_module_compiles_to_ptx_for_every_arch(compiled):
     assert compiled["failures"] == [], "CUDA compile errors:\n" + compiled["failure_report"]
     archs = compiled["archs"]

@@ -83,6 +83,7 @@ def _pst(monkeypatch, use_graph: bool):
     return sim, attach(sim)
 
 
+@pytest.mark.slow
 def test_captured_step_batch_is_pure_device_work(monkeypatch):
     """No allocation, host read or synchronisation inside the capture; the eager step's operations, graph_batch
     times; the same operations captured from another device state; replays equal the eager run bit for bit."""

@@ -86,6 +86,7 @@ def _flipped(src, dst, offset) -> str:
     return str(dst)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["closed", "killed"])
 def test_flipped_bytes_fail_fast_or_read_right(sources, tmp_path, monkeypatch, kind):
     """A byte flipped anywhere: read_run and every frame either read exactly the original numbers or raise one
@@ -113,6 +114,7 @@ def test_flipped_bytes_fail_fast_or_read_right(sources, tmp_path, monkeypatch, k
     assert caught >= len(offsets) // 2          # most of a small file is checksummed metadata or data
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["closed", "killed"])
 def test_truncated_files_fail_fast(sources, tmp_path, monkeypatch, kind):
     monkeypatch.setenv("MPM_WARP_OPEN_TIMEOUT", str(TIMEOUT))
@@ -127,6 +129,7 @@ def test_truncated_files_fail_fast(sources, tmp_path, monkeypatch, kind):
         assert time.perf_counter() - t0 < TIMEOUT + 5.0
 
 
+@pytest.mark.slow
 def test_data_flip_is_caught_by_the_chunk_checksum(sources, tmp_path):
     """One byte of frame 2's positions, in a closed file: Fletcher-32 fails that frame, the others read."""
     with h5py.File(sources["closed"], "r") as f:
@@ -139,6 +142,7 @@ def test_data_flip_is_caught_by_the_chunk_checksum(sources, tmp_path):
         run.frame(2)
 
 
+@pytest.mark.slow
 def test_cli_on_a_damaged_killed_run_exits_2_within_seconds(sources, tmp_path):
     """`plot`, `render`, `resume` on a killed writer's file with a flipped metadata byte: exit 2, one line, in
     about the probe's time box (the SWMR open itself would never return)."""

@@ -41,6 +41,7 @@ def test_full_mode_is_budgeted_under_eight_minutes():
     assert full["budget_s_total"] == sum(full["budget_s"].values()) <= 450
 
 
+@pytest.mark.slow
 def test_every_part_ran_within_its_budget(quick):
     res, _ = quick
     env = res["environment"]
@@ -52,12 +53,14 @@ def test_every_part_ran_within_its_budget(quick):
         assert 0 < part["seconds"] <= part["budget_s"] == quick_plan["budget_s"][name]
 
 
+@pytest.mark.slow
 def test_device_tests_ran_and_passed(quick):
     t = quick[0]["parts"]["tests"]["result"]
     assert list(t["modules"]) == plan(quick=True)["test_modules"]
     assert t["all_passed"] and t["tests"] >= 9 and t["failures"] == t["errors"] == 0
 
 
+@pytest.mark.slow
 def test_graph_replay_equals_eager_bit_for_bit(quick):
     for name in ("graph", "graph_deterministic"):
         g = quick[0]["parts"][name]["result"]
@@ -65,6 +68,7 @@ def test_graph_replay_equals_eager_bit_for_bit(quick):
         assert g["steps"] == 6 + g["graph_batch"] and all(v == 0.0 for v in g["max_abs_difference"].values())
 
 
+@pytest.mark.slow
 def test_bytes_per_particle(quick):
     rows = {(r["dim"], r["material"]): r for r in quick[0]["parts"]["memory"]["result"]["rows"]}
     # float32: x, v (4 dim B each), C, H = F_E - I (4 dim^2 B each); Cam-Clay adds log_Jp (4 B) and, in 2D, h_zz (4 B)
@@ -78,6 +82,7 @@ def test_bytes_per_particle(quick):
                                                              / r["n_particles"])
 
 
+@pytest.mark.slow
 def test_throughput_rows(quick):
     res, out = quick
     part = res["parts"]["throughput"]["result"]
@@ -102,6 +107,7 @@ def test_throughput_rows(quick):
     assert taichi[(3, "elastic")]["com_y_after"] == pytest.approx(el["com_y"], abs=1e-6)
 
 
+@pytest.mark.slow
 def test_pst_ran(quick):
     p = quick[0]["parts"]["pst"]["result"]
     assert p["steps"] > 0 and p["n_particles"] > 0 and p["sim_time_s"] == pytest.approx(0.002, abs=1e-12)

@@ -68,6 +68,7 @@ def _limited_run(tmp_path, limit: int) -> tuple[int, str]:
     return p.returncode, "\n".join(ln for ln in p.stderr.splitlines() if "CUDA" not in ln)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("phase", ["run file", "first checkpoint", "frame"])
 def test_file_size_limit_is_one_line_and_resumes_bit_for_bit(reference, tmp_path, capsys, phase):
     """The limit at 8 KiB (the run file's layout), 4 KiB under the checkpoint's size (its first checkpoint, where

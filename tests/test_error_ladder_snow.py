@@ -30,6 +30,8 @@ from mpm_warp.loader import load_scenario
 from mpm_warp.scenes.pst import cut_run
 from mpm_warp.studies.snow import LADDER_PST
 
+pytestmark = pytest.mark.slow
+
 #: the shear ladder's finest level (24 cells across the layer): error_vs_runtime_snow.json
 FINEST = {"peak": 932.5898344665492, "delta_s": 0.0020884051965618265, "collapse": 0.3054789884530086}
 

@@ -50,6 +50,7 @@ def test_a_table_row_becomes_a_profile_or_one_line(tmp_path):
         table_profiles(tmp_path / "broken.csv")
 
 
+@pytest.mark.slow
 def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     """The first run stops after one case (as a kill would); the second keeps that case's files untouched and runs
     the other on the 2 threads its protocol asks for."""

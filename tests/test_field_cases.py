@@ -202,6 +202,7 @@ def test_a_record_with_a_gap_in_its_slab_is_kept_apart_from_the_others():
     assert dataclasses.is_dataclass(cases[0])
 
 
+@pytest.mark.slow
 def test_a_slab_of_1000_layers_runs_and_its_run_file_names_every_group(tmp_path):
     """A profile from a snow micro-penetrometer has hundreds of layers: 1,000 slab layers of 0.2 mm build, run and
     write a run file whose group id (uint16 past 256 groups) names each of the 1,002 groups."""

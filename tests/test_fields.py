@@ -56,6 +56,7 @@ def pst_run(tmp_path_factory):
     return read_run(out), res
 
 
+@pytest.mark.slow
 def test_pst_collapse_is_measured_from_the_settled_layer(pst_run):
     """The settled, intact layer has collapse ~0 (not its consolidation 1 - exp(log_jp(0))); the sawn,
     debonded layer collapses under the slab; the monitor's collapse height is the same field."""

@@ -39,6 +39,7 @@ def test_settled_column_without_the_closure_carries_half_and_double_the_load_bes
     assert r["worst"] > 0.5
 
 
+@pytest.mark.slow
 def test_settled_column_with_the_closure_carries_the_overburden_in_every_row():
     """With ``scene.interface_closure`` every row within 3 cells of the layer (layer, substratum and slab
     rows) is within 5 % of the overburden at its height, at 3 and 4 cells (measured: 0.6 % and 0.55 %)."""

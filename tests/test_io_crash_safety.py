@@ -24,6 +24,8 @@ import pytest
 
 from mpm_warp.io import RunWriter, read_checkpoint, read_run
 
+pytestmark = pytest.mark.slow
+
 CHILD = r"""
 import signal, sys
 import numpy as np

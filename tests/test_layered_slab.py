@@ -69,6 +69,7 @@ def test_layered_slab_builds_one_block_per_layer_and_loads_the_layer():
     assert p.calibrated().xi == pytest.approx(mean.calibrated().xi, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_layered_slab_settles_to_its_overburden():
     # at rest every layer carries the weight above it: sigma_yy at a layer's mid-height is -(sum rho g h above +
     # half its own); a 0.6 m column, the middle 0.2 m (away from the free ends)

@@ -57,6 +57,7 @@ def _particle_arrays(state, *counts: int) -> int:
                if isinstance(a, wp.array) and k not in ("clock", "steps") and a.shape[0] in counts)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(SCENES))
 def test_estimate_equals_the_allocation(name):
     sc, threads = SCENES[name]()

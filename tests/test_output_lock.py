@@ -107,6 +107,7 @@ def test_second_run_on_a_live_output_fails_at_once_naming_the_holder(tmp_path, c
     assert out.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_two_cli_runs_started_together_one_wins(tmp_path):
     """Two `mpm-warp run` on the same --out started together: one writes the run, the other exits 2 at once."""
     out = str(tmp_path / "run.h5")

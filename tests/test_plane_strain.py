@@ -133,6 +133,7 @@ def test_p_wave_speed_2d():
     assert np.abs(F[:, 1, 1] - 1).max() < 1e-5 and np.abs(F[:, 2, 2] - 1).max() == 0.0  # elastic: F_zz = 1
 
 
+@pytest.mark.slow
 def test_self_weight_column_2d():
     """sigma_yy = -rho g (H - Y) at rest, 2D, within the 3D test's bound (1 % of rho g H at 16 cells)."""
     rec = self_weight_column(1.0 / 16.0, dimension=2)

@@ -183,6 +183,7 @@ def _sim(scenario):
     return sim, attach(sim)
 
 
+@pytest.mark.slow
 def test_a_fork_with_a_shorter_cut_is_the_run_with_that_cut():
     """A run forked from a snapshot taken before its saw stops equals the run made with that cut from t = 0."""
     sc = load_scenario("pst_demo", TINY + ["scene.saw.cut_length=0.08"])
@@ -217,6 +218,7 @@ def test_critical_cut_reports_a_bracket_it_cannot_hold():
     assert all(t["t_end"] == pytest.approx(p.saw_start + t["cut"] / p.saw.speed + 0.005) for t in res.trials)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("workers", [1, 2])
 def test_critical_cut_bisects_and_runs_the_first_two_trials_at_once(monkeypatch, workers):
     """The search's bookkeeping, with each trial's outcome set by its cut (threshold 0.07 m): the bracket,
@@ -262,6 +264,7 @@ SMALL_DEMO = ["scene.length=1.2", "scene.dx=0.01", "scene.substratum_thickness=0
               "time.frame_interval=0.005"]
 
 
+@pytest.mark.slow
 def test_pst_demo_small_crack_runs_away_from_the_saw(tmp_path):
     out = str(tmp_path / "pst.h5")
     res = mw.run("pst_demo", output=out, device=DEVICE, overrides=SMALL_DEMO, n_threads=1)

@@ -99,6 +99,7 @@ def test_the_slab_crack_detector_finds_a_through_crack_and_not_a_partial_one():
     assert plain.slab_crack is None and "slab_crack" not in plain.units()
 
 
+@pytest.mark.slow
 def test_a_soft_thin_slab_breaks_over_the_cut(tmp_path):
     out = tmp_path / "sf.h5"
     res = mw.run("pst_demo", output=str(out), overrides=SOFT_THIN + ["output.fields=['x','damage']"])

@@ -39,6 +39,7 @@ def _halfway_frame(run) -> int:
     return int(hit[0]) if len(hit) else run.n_frames - 1
 
 
+@pytest.mark.slow
 def test_flat_pst_picture(running_pst, tmp_path):
     run = mw.read_run(running_pst)
     k = running_frame(run, scene_params(run))
@@ -54,6 +55,7 @@ def test_flat_pst_picture(running_pst, tmp_path):
     assert purple > 1000 and lighter > 200
 
 
+@pytest.mark.slow
 def test_sloped_pst_picture(sloped_pst, tmp_path):
     run = mw.read_run(sloped_pst)
     p = scene_params(run)
@@ -64,6 +66,7 @@ def test_sloped_pst_picture(sloped_pst, tmp_path):
     _not_blank(img)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("which", ["running_pst", "sloped_pst"])
 def test_cli_plot_of_a_pst(which, request, tmp_path, capsys):
     path = request.getfixturevalue(which)
@@ -80,6 +83,7 @@ def test_not_a_pst_is_refused_by_name(tmp_path):
         pst_picture(out, str(tmp_path / "p.png"))
 
 
+@pytest.mark.slow
 def test_plotting_a_run_file_starts_no_simulation(running_pst, tmp_path, monkeypatch):
     """Post only reads run files: the stored calibration, never a material-point drive or a Simulation."""
     import mpm_warp.material_point as material_point

@@ -79,6 +79,7 @@ def _run(mode: str):
     return sim, mon, early
 
 
+@pytest.mark.slow
 def test_pst_2d_equals_slab():
     """Fronts, collapse, touchdown, markers and the first particle layer of the slab against the 2D run's."""
     s2, m2, e2 = _run("2d")

@@ -58,6 +58,7 @@ def sawn_and_pre_cut():
     return _settled(_with(0.0), t_end), _settled(_with(CUT), t_end)
 
 
+@pytest.mark.slow
 def test_a_pre_cut_column_settles_as_the_sawn_one(sawn_and_pre_cut):
     """The same 192 particles cut; the slab over the kerf comes down as far (measured: 88.2 against 88.4 um,
     -0.3 %). That the kerf is there while settling is the kernel test's (tests/test_pst.py)."""

@@ -81,6 +81,7 @@ def test_a_missing_profile_is_refused_naming_it(tmp_path):
         scenario_from_dict(raw)
 
 
+@pytest.mark.slow
 def test_the_profile_runs_to_a_picture_and_a_summary_in_one_command(tmp_path, capsys):
     out = tmp_path / "pit.h5"
     argv = ["run", "pst_profile", "--out", str(out), "--plot", "--quiet", "--set", "scene.length=0.4",

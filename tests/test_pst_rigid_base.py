@@ -50,6 +50,7 @@ def test_a_rigid_base_leaves_out_the_substratum():
     assert sc.walls[0].kind == "sticky" and sc.walls[0].point[1] == 0.0       # the weak layer lies on the bed
 
 
+@pytest.mark.slow
 def test_on_a_rigid_base_the_slab_settles_by_the_weak_layer_alone(settled):
     """Measured -16.5 um against -16.3 um (+1.1 %); a bed that let the layer's base move would add to it."""
     p = COLUMN
@@ -58,6 +59,7 @@ def test_on_a_rigid_base_the_slab_settles_by_the_weak_layer_alone(settled):
     assert -settled[True] == pytest.approx(weak, rel=0.05)
 
 
+@pytest.mark.slow
 def test_the_substratum_adds_its_own_shortening(settled):
     """Elastic substratum minus rigid base: measured 17.3 um against the closed form's 16.3 um (+5.6 %)."""
     p = COLUMN

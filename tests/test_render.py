@@ -83,6 +83,7 @@ def _expected_column(meta: dict, x: float) -> float:
     return w / 2 + (x - cam["focal_point"][0]) * h / (2 * cam["parallel_scale"]) - 0.5
 
 
+@pytest.mark.slow
 def test_side_view_size_content_and_front_marker(pst, tmp_path):
     out = render.render_run(pst, field="collapse", out_dir=tmp_path, size=(640, 360))
     assert out.pngs == [str(tmp_path / f"collapse_{i:04d}.png") for i in range(4)] and out.video is None
@@ -128,6 +129,7 @@ def test_front_of_a_pst_run_is_converted_to_x(tmp_path, from_end):
     assert _near(img, render.BELOW_COLOR, tol=3) > 100
 
 
+@pytest.mark.slow
 def test_colour_range_is_the_data_range_over_the_film(pst, tmp_path):
     run = read_run(pst)
     collapse = [1 - np.exp(run.frame(i)["log_jp"].astype(float)) for i in range(run.n_frames)]
@@ -213,6 +215,7 @@ def test_cli_render(pst, tmp_path, capsys):
         main(["render", pst, "--field", "nope"])
 
 
+@pytest.mark.slow
 def test_end_to_end_elastic_block(block, tmp_path):
     run = read_run(block)
     out = render.render_run(block, field="displacement", out_dir=tmp_path, size=(480, 320))

@@ -17,6 +17,8 @@ from mpm_warp.errors import InvalidArgument
 from mpm_warp.io import read_run
 from mpm_warp.post import render
 
+pytestmark = pytest.mark.slow
+
 
 def _rgb(png) -> np.ndarray:
     return np.asarray(Image.open(png))[..., :3].astype(int)

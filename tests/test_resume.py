@@ -53,6 +53,7 @@ def test_checkpoint_holds_the_full_state(tmp_path):
     np.testing.assert_array_equal(arrays["x"], run.frame(-1)["x"])
 
 
+@pytest.mark.slow
 def test_cli_interrupted_by_signal_keeps_frames_and_resumes(tmp_path):
     """A real `mpm-warp run` gets SIGINT mid-run: it stops after a complete frame, exit 130, and resumes."""
     out = tmp_path / "cli.h5"
@@ -128,6 +129,7 @@ def _interrupted_equals_uninterrupted(tmp_path, scene: str, overrides: list, t_s
     return full, res, arrays
 
 
+@pytest.mark.slow
 def test_pst_interrupted_after_settling_resumes_bit_for_bit(tmp_path):
     full, res, arrays = _interrupted_equals_uninterrupted(
         tmp_path, "pst_demo", PST, 0.055, ["weak_layer/ref", "weak_layer/sawn", "weak_layer/arrival", "base_y_ref",
@@ -141,6 +143,7 @@ def test_pst_interrupted_after_settling_resumes_bit_for_bit(tmp_path):
     np.testing.assert_array_equal(full.monitor.base_arrival.numpy(), res.monitor.base_arrival.numpy())
 
 
+@pytest.mark.slow
 def test_pst_resumed_after_the_saw_stopped_on_runaway_keeps_the_stop(tmp_path):
     """saw.stop = "runaway": the blade stops near 0.18 m at 0.22 s; stopped at 0.25 s and resumed, the blade stays
     there (it would go on to 0.5 m) and the run is the uninterrupted one, bit for bit."""
@@ -177,6 +180,7 @@ def test_resume_on_another_thread_count(tmp_path):
     np.testing.assert_allclose(b.frame(-1)["x"], a.frame(-1)["x"], atol=1e-6)
 
 
+@pytest.mark.slow
 def test_pst_with_the_interface_closure_resumes_bit_for_bit(tmp_path):
     """The closure's factors come from the initial positions (docs/model.md §5b), so a resume rebuilds them and
     continues bit for bit."""

@@ -67,6 +67,7 @@ def test_no_propagation_is_its_own_class():
     assert classify(plain, t, stuck, saw_cut=math.nan)["class"] == "ARR"
 
 
+@pytest.mark.slow
 def test_the_blade_stops_where_the_crack_ran_away(tmp_path):
     out = str(tmp_path / "runaway.h5")
     res = mw.run("pst_demo", out, DEVICE, RUNAWAY, n_threads=1)
@@ -96,6 +97,7 @@ def test_the_blade_stops_where_the_crack_ran_away(tmp_path):
     assert run.scenario["scene"]["saw"]["stop"] == "runaway"
 
 
+@pytest.mark.slow
 def test_a_column_that_cannot_propagate_ends_no_propagation():
     res = mw.run("pst_demo", None, DEVICE, NO_RUNAWAY, n_threads=1)
     mon, r = res.monitor, res.scene_result
@@ -107,6 +109,7 @@ def test_a_column_that_cannot_propagate_ends_no_propagation():
     assert math.isnan(o["saw_stopped_at"]) and o["saw_stopped_at_null"] == r["saw_stopped_at_null"]
 
 
+@pytest.mark.slow
 def test_the_default_never_moves_the_blade_and_is_the_parents_run(monkeypatch):
     calls = []
     monkeypatch.setattr(WeakLayerTracker, "stop_blade", lambda self, position: calls.append(position))

@@ -21,6 +21,8 @@ from helpers_validation import DEVICE
 
 import mpm_warp as mw
 
+pytestmark = pytest.mark.slow
+
 L, D, D_WL, DX = 1.2, 0.3, 0.03, 0.015
 OLD_KE_PER_DEPTH = 1.9e-6   # J/m
 OLD_CREEP = 0.31e-3         # m/s

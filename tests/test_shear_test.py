@@ -63,6 +63,7 @@ def runs():
     return {n: _run(n) for n in (4, 8)}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cells", [4, 8])
 def test_shear_test_peak_softening_collapse(runs, cells):
     res = runs[cells]
@@ -93,6 +94,7 @@ def test_shear_test_peak_softening_collapse(runs, cells):
     assert c["u"][-1] == pytest.approx(0.01 * (c["t"][-1] - c["t"][0]), rel=0.05)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cells", [4, 8])
 def test_shear_test_interior_reaches_tau_p(runs, cells):
     """Away from the traction-free ends (one layer thickness) the layer's own peak is within 3 % of the given
@@ -103,6 +105,7 @@ def test_shear_test_interior_reaches_tau_p(runs, cells):
     assert ex["peak_shear_stress"] < ex["interior_peak_shear_stress"]
 
 
+@pytest.mark.slow
 def test_shear_test_converges_across_4_and_8_cells(runs):
     a, b = runs[4].scene_result, runs[8].scene_result
     assert a["peak_shear_stress"] == pytest.approx(b["peak_shear_stress"], rel=0.05)

@@ -48,6 +48,7 @@ def _slab_over_weak_layer(E_slab: float, E_wl: float, precision: str, dx: float 
     return sc, H_wl, H, settle, dt0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("E_slab, E_wl, precision, drift_tol", [
     pytest.param(1.0e6, 1.0e4, "float32", 1.0e-2, id="ratio100-float32"),
     pytest.param(1.0e7, 1.0e4, "float32", 1.0e-2, id="ratio1000-float32"),

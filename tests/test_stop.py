@@ -65,6 +65,7 @@ def overrides_frame(overrides) -> float:
     return float(next(o.split("=")[1] for o in overrides if o.startswith("time.frame_interval=")))
 
 
+@pytest.mark.slow
 def test_block_stopped_mid_frame_resumes_bit_for_bit(tmp_path):
     """An elastic block dropped on a frictional floor, stopped 100 steps into a 277-step frame (wall impulse
     half summed): the resumed run equals the straight one, wall forces included, on 1 and on 2 threads."""
@@ -77,6 +78,7 @@ def test_block_stopped_mid_frame_resumes_bit_for_bit(tmp_path):
                                         lambda s: s.stepper.clock()[2] > 100, threads)
 
 
+@pytest.mark.slow
 def test_pst_stopped_mid_frame_while_sawing_resumes_bit_for_bit(tmp_path):
     """A PST stopped half-way through a frame after settling (the saw cutting, yielded flags half collected)."""
     overrides = TINY_PST + ["time.end=0.065", "output.checkpoint_every=4", 'output.fields=["x", "log_jp", "yielded"]']
@@ -127,6 +129,7 @@ def _env() -> dict:
     return {**os.environ, "PYTHONPATH": os.pathsep.join([root, os.environ.get("PYTHONPATH", "")])}
 
 
+@pytest.mark.slow
 def test_cli_signal_during_a_long_frame_stops_within_seconds_and_resumes_exactly(tmp_path):
     """One frame of 0.8 s of simulated time (~5 s of wall time): SIGINT during it stops the run within seconds
     (exit 130) with a mid-frame checkpoint; `mpm-warp resume` ends on the uninterrupted run's last frame."""

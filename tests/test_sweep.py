@@ -80,6 +80,7 @@ def test_run_id_is_hash_of_effective_scenario():
 
 
 # --------------------------------------------------------------------------------- the sweep
+@pytest.mark.slow
 def test_sweep_equals_runs_made_one_by_one(scheduler, tmp_path):
     out = tmp_path / "sweep"
     res = run_sweep(SCENE, VARY, out_dir=out, overrides=TINY, scheduler=scheduler, device="cpu", progress=False)
@@ -107,6 +108,7 @@ def test_sweep_equals_runs_made_one_by_one(scheduler, tmp_path):
         assert rec["status"] == "ok" and rec["result"]["steps"] == ref.steps and rec["n_frames"] == 3
 
 
+@pytest.mark.slow
 def test_failed_case_reported_others_complete(scheduler, tmp_path):
     cases = tmp_path / "cases.csv"
     cases.write_text("materials.snow.E,materials.snow.nu\n1e6,\n2e6,\n1e6,0.7\n3e6,0.25\n")
@@ -121,6 +123,7 @@ def test_failed_case_reported_others_complete(scheduler, tmp_path):
         assert json.load(fh)["error"].startswith("InvalidArgument: materials.snow.nu")
 
 
+@pytest.mark.slow
 def test_killed_sweep_resumes_without_recomputing(scheduler, tmp_path):
     out = tmp_path / "sweep"
     vary = ["--vary", "materials.snow.E=1e6,2e6,3e6,4e6"]
@@ -160,6 +163,7 @@ def dying_runner(scenario, output, device):
     return mw.run(scenario, output, device)
 
 
+@pytest.mark.slow
 def test_run_of_dead_worker_is_retried(scheduler, tmp_path):
     out = tmp_path / "sweep"
     res = run_sweep(SCENE, {"materials.snow.E": [1e6, 2e6]}, out_dir=out, overrides=TINY, scheduler=scheduler,

@@ -40,6 +40,7 @@ def _stencil_moments_kernel(T):
 _KERNELS = {}
 
 
+@pytest.mark.slow
 def test_bspline_partition_of_unity_and_moments(precision):
     """sum w = 1, sum w (x_i - x_p) = 0, sum w (x_i - x_p)(x_i - x_p)^T = dx^2/4 I."""
     T = wp.float64 if precision == "float64" else wp.float32

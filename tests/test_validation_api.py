@@ -59,6 +59,7 @@ def test_self_weight_column_record():
     assert r["measured"] == pytest.approx(r["reference"], rel=0.02)
 
 
+@pytest.mark.slow
 def test_weak_layer_collapse_record():
     """Weak layer under a slab, 8 cells across it: mean 1 - J_P within 3 % of the closed form."""
     r = weak_layer_collapse(1.0 / 256.0, device=DEVICE)

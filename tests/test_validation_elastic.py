@@ -131,6 +131,7 @@ def _column_stress_error(n_cells: int) -> dict:
     }
 
 
+@pytest.mark.slow
 def test_column_self_weight_stress():
     """Column with lateral rollers at rest: sigma_yy(Y) = -rho g (H - Y) (Y reference height).
 

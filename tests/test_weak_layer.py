@@ -157,6 +157,7 @@ def test_oedometric_ratio_closed_form():
     assert oedometric_ratio(1.0, 0.3) == pytest.approx(1.08475, rel=1e-5)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("xi, rho_slab, p0_ini", [(0.04, 1200.0, 0.0), (0.02, 2400.0, 200.0)])
 def test_weak_layer_collapse_under_slab(xi, rho_slab, p0_ini):
     """Slab on a weak layer, 8 cells across it (float32): 1 - J_P and h_c against the closed form.
@@ -183,6 +184,7 @@ def test_weak_layer_collapse_under_slab(xi, rho_slab, p0_ini):
     assert m["q_over_p"] > 0.15  # 0.265 in float64; the float32 creep lowers it (test_settled_layer_does_not_creep)
 
 
+@pytest.mark.slow
 def test_collapse_converges_with_dx():
     """The layer under-compacts in the cell it shares with the slab: the deficit falls with dx.
 
@@ -199,6 +201,7 @@ def test_collapse_converges_with_dx():
     assert abs(errs[1]) < abs(errs[0]) / 3.0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("precision", [
     "float32",
     "float64"])

@@ -4,7 +4,8 @@ Clones the committed checkout (``git clone``: committed files only, as CI sees t
 with an empty Warp kernel cache, and runs the README's commands there exactly as written, each ``&&`` part
 timed on its own: the main job's (``python3 -m venv``, ``pip install -e .``, ``mpm-warp run pst_demo ...
 --plot``) and, with ``--tests``, the test command (the same as ``.ci/run``). The run file gives the
-particles, steps and frames of the main job, hence its particle-steps per second.
+particles, steps and frames of the main job, hence its particle-steps per second. On the plain install,
+``mpm-warp field`` on a one-row table must say in one line that it needs the field extra (exit 2).
 
 Writes ``benchmarks/perf/results/fresh_clone.json``. Quote it from a quiet machine: its environment record
 holds the load average at the start and the end. Packages come from whatever index pip is configured with
@@ -26,7 +27,7 @@ import time
 import h5py
 
 from mpm_warp.studies.environment import environment, git_commit, write_json
-from mpm_warp.studies.fresh_clone import readme_commands, split_parts
+from mpm_warp.studies.fresh_clone import FIELD_TABLE, plain_field_verdict, readme_commands, split_parts
 from mpm_warp.studies.protocol import out_dir, parser
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -54,6 +55,18 @@ def run_file_counts(path: str) -> dict:
         return {"n_particles": int(f.attrs["n_particles"]), "steps": steps, "frames": int(f["step"].shape[0])}
 
 
+def field_on_plain_install(clone: str, env: dict) -> dict:
+    """``mpm-warp field`` on a one-row table in the clone's venv (the plain install), judged."""
+    table = os.path.join(clone, "field_check.csv")
+    with open(table, "w") as fh:
+        fh.write(FIELD_TABLE)
+    p = subprocess.run([os.path.join(".venv", "bin", "mpm-warp"), "field", table, "--out", "field_check"], cwd=clone,
+                       env=env, capture_output=True, text=True)
+    verdict = plain_field_verdict(p.returncode, p.stderr)
+    print(f"  plain install, mpm-warp field: rc {p.returncode}, {'ok' if verdict['ok'] else 'NOT ok'}", flush=True)
+    return verdict
+
+
 def main(argv=None) -> int:
     ap = parser(__doc__, "the main job to time.end=0.02")
     ap.add_argument("--tests", action="store_true", help="also time the README's test command")
@@ -78,10 +91,13 @@ def main(argv=None) -> int:
         if os.path.exists(h5):
             data["main_job"].update(run_file_counts(h5))
             data["main_job"]["pictures"] = sorted(os.listdir(os.path.join(clone, "pst_demo_plots")))
+        if os.path.exists(os.path.join(clone, ".venv", "bin", "mpm-warp")):
+            data["field_plain_install"] = field_on_plain_install(clone, env)
         if args.tests:
             shutil.rmtree(os.path.join(clone, ".venv"))                # the test command makes its own venv
             data["tests"] = {"parts": run_parts(commands["tests"], clone, env, log)}
-    data["ok"] = all(p["rc"] == 0 for k in ("main_job", "tests") if k in data for p in data[k]["parts"])
+    data["ok"] = all(p["rc"] == 0 for k in ("main_job", "tests") if k in data for p in data[k]["parts"]) and \
+        data.get("field_plain_install", {}).get("ok", True)
     name = "fresh_clone" + ("_quick" if args.quick else "")
     print(write_json(name, data, out_dir(args, RESULTS, "fresh_clone")))
     if args.keep:

@@ -33,7 +33,10 @@ _KAPPA = 5.0 / 6.0                     # shear correction of a rectangular secti
 
 
 class WeacUnavailable(MPMError, ImportError):
-    """weac is not installed, or its version has another API than weac 2.6.x."""
+    """weac is not installed, or its version has another API than weac 2.6.x.
+
+    ``name`` is the missing package (weac, or one weac imports) when one is missing, else None.
+    """
 
 
 def weac_version() -> str | None:
@@ -58,13 +61,16 @@ def weac_unavailable() -> str | None:
 
 def _weac():
     """The weac module (imported here, at first use); :class:`WeacUnavailable` with its one line otherwise."""
-    why = weac_unavailable()
+    why, missing = weac_unavailable(), None
     if why is None:
         try:
             return importlib.import_module("weac")
         except ImportError as exc:           # metadata present, package broken or hidden
             why = f"{NOT_INSTALLED} (import failed: {exc})"
-    raise WeacUnavailable(why)
+            missing = exc.name if isinstance(exc, ModuleNotFoundError) else None
+    elif weac_version() is None:
+        missing = "weac"
+    raise WeacUnavailable(why, name=missing)
 
 
 @dataclass(frozen=True)

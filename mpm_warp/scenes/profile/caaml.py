@@ -33,7 +33,7 @@ def import_snowprofile():
         import snowprofile.io as sp_io
     except ImportError as e:
         raise ProfileLibraryMissing(f"reading a CAAML snow profile needs the snowprofile library ({e}): "
-                                    f"{INSTALL}") from None
+                                    f"{INSTALL}", e) from None
     return sp_io
 
 

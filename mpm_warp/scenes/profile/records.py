@@ -31,7 +31,13 @@ class ProfileError(InvalidArgument):
 
 
 class ProfileLibraryMissing(MPMError, ImportError):
-    """The optional CAAML library (snowprofile) is not installed."""
+    """An optional CAAML reader (snowprofile, snowpylot) is not installed.
+
+    ``name`` is the missing package when ``cause``, the failed import, is a :class:`ModuleNotFoundError`.
+    """
+
+    def __init__(self, message: str, cause: ImportError | None = None):
+        super().__init__(message, name=cause.name if isinstance(cause, ModuleNotFoundError) else None)
 
 
 def metres(x: float) -> str:

@@ -84,7 +84,7 @@ def read_snowpilot(data: bytes, path: str) -> SnowProfileData:
         from snowpylot import caaml_parser
     except ImportError as e:
         raise ProfileLibraryMissing(f"reading a SnowPilot profile needs the snowpylot library ({e}): "
-                                    "pip install 'mpm-warp[profile]'") from None
+                                    "pip install 'mpm-warp[profile]'", e) from None
     try:
         pit = caaml_parser(io.BytesIO(data))
     except (ET.ParseError, AttributeError, ValueError, TypeError, IndexError) as e:
