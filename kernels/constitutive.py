@@ -49,7 +49,7 @@ def material_struct(T):
     volume since then is ``exp(log_jp - log_jp_ref)`` (``log_jp`` starts at a consolidation's state,
     not at 0) and the Cauchy stress is ``tau / (J_E exp(log_jp - log_jp_ref))``.
 
-    Derived constants (the engine fills them from the fields above, ``mpm_warp.model.material_params``):
+    Derived constants (the engine fills them from the fields above, ``mpm_warp.particle_groups.material_params``):
     ``K`` (bulk modulus ``lam + 2 mu / 3``, Pa) and ``inv_K`` (1/Pa); ``ell_rho``, ``ell_inv_rho``, ``ell_c``,
     ``ell_inv_c`` (-): Cam-Clay's scaled yield ellipse (``kernels.camclay.ellipse_axes``), so that a yielding
     particle's return forms no square root or reciprocal of material constants.

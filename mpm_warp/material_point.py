@@ -29,7 +29,7 @@ from .kernels.constitutive import material_struct
 from .kernels.material_point import drive_kernel
 from .kernels.types import mat, vec
 from .materials import CamClaySnow, Elastic, lame_parameters
-from .model import material_params
+from .particle_groups import material_params
 
 __all__ = ["drive_material_points", "isotropic_compression", "lame_parameters", "strain_path"]
 

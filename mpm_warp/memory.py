@@ -10,7 +10,7 @@ momentum; one copy per CPU thread, :func:`mpm_warp.step.grid_copies`). The host 
 positions and the initial positions ``x0`` in float64 (``2 d 8`` bytes per particle) and builds the
 initial ``x``, ``v``, ``C`` before uploading them. Frames and checkpoints add host copies of the fields
 they write (not counted). ``tests/test_memory.py`` checks these numbers against what
-:class:`~mpm_warp.model.State`, :class:`~mpm_warp.step.Stepper` and :class:`~mpm_warp.Simulation` really
+:class:`~mpm_warp.state.State`, :class:`~mpm_warp.step.Stepper` and :class:`~mpm_warp.Simulation` really
 allocate.
 
 The guard (:func:`check_memory`) compares the estimate with the memory available (Linux
@@ -29,7 +29,7 @@ import warp as wp
 
 from .config import Scenario
 from .errors import InvalidArgument
-from .model import grid_shape, lattice_counts
+from .lattice import grid_shape, lattice_counts
 from .step import grid_copies
 
 __all__ = ["MemoryEstimate", "estimate_memory", "available_memory", "check_memory", "parse_bytes",

@@ -1,6 +1,6 @@
 """The whole state of a run as host arrays: checkpoints, resume, and forks of a run.
 
-A snapshot is ``(arrays, meta)``: the particle state and clock (:meth:`mpm_warp.model.State.arrays`),
+A snapshot is ``(arrays, meta)``: the particle state and clock (:meth:`mpm_warp.state.State.arrays`),
 the next step's speed bound, a frame's part-collected wall impulses and every monitor's state
 (saw flags, reference fields, arrival times, series), with the frame count and the scenario in
 ``meta``. Loaded into a simulation of the same scenario it continues bit for bit on the CPU

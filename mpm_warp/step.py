@@ -5,6 +5,10 @@ P2G (one launch per particle group, with the Cam-Clay return compiled in only
 for plastic groups), grid update (wall code only when walls exist), G2P and
 the clock update. No host read-back happens inside a step; on CUDA a batch of
 steps is captured once as a graph and replayed.
+
+The launches of each phase are recorded by :mod:`mpm_warp.step_phases`; this module
+sizes the plan (threads and grid copies), runs it (on the CPU over threads that meet
+between stages, on CUDA as graphs) and reads the clock and counters between batches.
 """
 
 from __future__ import annotations
@@ -18,17 +22,11 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import warp as wp
 
-from .interfaces import closure_factors
-from .kernels.crack_band import column_sums_zero_kernel, kappa_column_mean_kernel, kappa_column_sum_kernel
+from . import step_phases as phases
 from .kernels.fpmode import flush_kernels
-from .kernels.g2p import g2p_kernel
-from .kernels.grid_update import grid_update_kernel, wall_state_kernel
-from .kernels.interface_closure import closure_kernel
-from .kernels.p2g import p2g_kernel
-from .kernels.timestep import begin_step_kernel, end_step_kernel
 from .kernels.types import vec
 from .meeting import MeetingPoint
-from .model import Model, State, material_params
+from .model import Model, State
 from .step_profile import refuse_no_ops, stage_walls, timed
 
 __all__ = ["Stepper", "default_threads", "grid_copies"]
@@ -57,12 +55,6 @@ def _no_wait() -> None:  # the meeting of a one-thread step: nothing to wait for
     pass
 
 
-def _chunks(start: int, end: int, n: int) -> list[tuple[int, int]]:
-    """Split ``[start, end)`` into ``n`` contiguous near-equal ranges."""
-    edges = np.linspace(start, end, n + 1).round().astype(int)
-    return [(int(edges[k]), int(edges[k + 1])) for k in range(n)]
-
-
 class Stepper:
     """Launch plan for one model and state.
 
@@ -86,25 +78,18 @@ class Stepper:
         T = model.T
         dev = model.device
         dim = model.dim
-        V = vec(dim, T)
-        Vi = wp.types.vector(dim, wp.int32)
         nt = self.n_threads = grid_copies(dev, model.n_particles, model.grid_shape, n_threads)
         gs = model.grid_shape
-        n_nodes = int(np.prod(gs))
-        # the kernels see the grid flat (node (i, j[, k]) at i s_0 + j s_1 [+ k]), copy k at k n_nodes
-        strides = Vi(*[int(np.prod(gs[a + 1:])) for a in range(dim)])
         # (flat buffers held by the recorded launches and the views below only, so the stepper's own arrays
         # count the grid once)
-        grid_m_flat = wp.zeros(nt * n_nodes, dtype=T, device=dev)
-        grid_p_flat = wp.zeros(nt * n_nodes, dtype=V, device=dev)
+        grid = phases.step_grid(model, nt)
         #: per-thread grid copies (views of the flat buffers): nodal masses (kg) and momenta (kg m/s)
-        self.grid_m_all = grid_m_flat.reshape((nt, *gs))
-        self.grid_p_all = grid_p_flat.reshape((nt, *gs))
+        self.grid_m_all = grid.m.reshape((nt, *gs))
+        self.grid_p_all = grid.p.reshape((nt, *gs))
         #: summed nodal mass (kg) and, after the grid update, nodal velocity (m/s)
         self.grid_m = self.grid_m_all[0]
         self.grid_p = self.grid_p_all[0]
-        self._grid_copies = [(grid_m_flat[k * n_nodes:(k + 1) * n_nodes],
-                              grid_p_flat[k * n_nodes:(k + 1) * n_nodes]) for k in range(nt)]
+        self._grid_copies = grid.copies
         self.dt = wp.zeros(1, dtype=T, device=dev)
         self.vmax = wp.zeros(nt, dtype=T, device=dev)
         self.seed_vmax()
@@ -118,105 +103,24 @@ class Stepper:
             saved = wp.zeros(nt, dtype=wp.int32, device=dev)
             self._fp = [tuple(wp.launch(kern, 1, inputs=[saved, k], device=dev, record_cmd=True)
                               for kern in flush_kernels()) for k in range(nt)]
-        has_walls = bool(model.walls)
         nw = max(len(model.walls), 1)
-        self.wall_impulses = wp.zeros((nt, nw), dtype=vec(dim, wp.float64), device=dev) if has_walls else None
+        self.wall_impulses = wp.zeros((nt, nw), dtype=vec(dim, wp.float64), device=dev) if model.walls else None
         self.fixed_dt = model.scenario.time.dt
-        tc = model.scenario.time
-        dt_max = tc.dt_max if tc.dt_max > 0 else 1e30
-        origin = V(*model.origin)
-        inv_dx = T(1.0 / model.dx)
-        dx = T(model.dx)
-        shape = Vi(*model.grid_shape)
         s = state
 
-        self._begin = wp.launch(begin_step_kernel(T), 1, inputs=[s.clock, self.vmax, tc.cfl, model.dx, model.c_p,
-                                                                 self.fixed_dt, dt_max, self.dt],
-                                device=dev, record_cmd=True)
-        # per thread k: P2G launches, grid-update slab, G2P range
-        self._p2g: list[list] = [[] for _ in range(nt)]
-        # fields a group does not have (never read: the kernel is built without them) are passed as one-element
-        # arrays, not None: Warp's CPU code takes its contiguous fast path only when every array is contiguous
-        unused = {t: wp.zeros(1, dtype=t, device=dev) for t in (T, wp.uint8)}
-        for g in model.groups:
-            mat = g.material
-            plastic = mat.plastic
-            k_p2g = p2g_kernel(dim, T, mat.model, plastic and s.yielded is not None)
-            m_par = material_params(mat, T)
-            for k, (a, b) in enumerate(_chunks(g.start, g.end, nt)):
-                if b <= a:
-                    continue
-                sl = slice(a, b)
-                ljp, kap, yld, hz = unused[T], unused[T], unused[wp.uint8], unused[T]
-                if g.kappa_start >= 0:
-                    kap = s.kappa[g.kappa_start + a - g.start:g.kappa_start + b - g.start]
-                if plastic:
-                    psl = slice(g.plastic_start + a - g.start, g.plastic_start + b - g.start)
-                    ljp = s.log_jp[psl]
-                    yld = s.yielded[psl] if s.yielded is not None else yld
-                    hz = s.hzz[psl] if s.hzz is not None else hz
-                self._p2g[k].append(wp.launch(
-                    k_p2g, b - a,
-                    inputs=[s.x[sl], s.v[sl], s.C[sl], s.H[sl], hz, ljp, kap, yld, T(g.mass), T(g.vol0), m_par,
-                            self.dt, origin, inv_dx, dx, shape, strides, *self._grid_copies[k], self.counts[k]],
-                    device=dev, record_cmd=True))
-        # the laminate closure at material interfaces (docs/model.md §5b): only for stacks, before every P2G
-        self._closure, self._closure_arrays = [], []
-        F3 = wp.types.vector(3, T)
-        for axis, idx, fac in closure_factors(model):
-            if len(idx) == 0:
-                continue
-            arrays = (wp.array(idx, dtype=wp.int32, device=dev), wp.array(fac.astype(model.np_dtype), dtype=F3,
-                                                                           device=dev))
-            self._closure_arrays.append(arrays)
-            self._closure.append(wp.launch(closure_kernel(dim, T), len(idx), inputs=[*arrays, axis, s.C, self.dt],
-                                           device=dev, record_cmd=True))
-        # walls at the end of the step, evaluated once per step for every node of the grid update
-        self._wall_state = None
-        wall_point = wall_velocity = None
-        if has_walls:
-            wall_point = wp.zeros(nw, dtype=V, device=dev)
-            wall_velocity = wp.zeros(nw, dtype=V, device=dev)
-            self._wall_state = wp.launch(wall_state_kernel(T, dim), nw,
-                                         inputs=[model.walls_device, self.dt, s.clock, wall_point, wall_velocity],
-                                         device=dev, record_cmd=True)
+        # the phases of the step, recorded in the order they run (mpm_warp.step_phases)
+        self._begin = phases.begin_step_launch(model, s, self.vmax, self.dt, self.fixed_dt)
+        # per thread k (one on CUDA): its P2G launches, grid-update slab and G2P range
+        self._p2g = phases.p2g_launches(model, s, grid, self.dt, self.counts, nt)
+        self._closure, self._closure_arrays = phases.closure_launches(model, s, self.dt)
+        self._wall_state, wall_point, wall_velocity = phases.wall_state_launch(model, s, self.dt)
         # grid update by rows of nodes along the last axis: a whole row per thread on the CPU, a node on CUDA
-        rows = int(np.prod(gs[:-1]))
         seg_len = 1 if wp.get_device(dev).is_cuda else gs[-1]
-        per_row = gs[-1] // seg_len
-        self._grid = []
-        for k, (a, b) in enumerate(_chunks(0, rows, nt)):
-            self._grid.append(wp.launch(
-                grid_update_kernel(dim, T, has_walls), (b - a) * per_row,
-                inputs=[grid_m_flat, grid_p_flat, nt, a, seg_len, shape, strides, self.dt, s.clock,
-                        V(*model.gravity), T(tc.gravity_ramp), T(tc.damping),
-                        T(tc.damping_until if tc.damping > 0 else 0.0), T(model.mass_threshold), origin, dx,
-                        model.walls_device, wall_point, wall_velocity,
-                        self.wall_impulses[k] if has_walls else None, self.vmax[k:k + 1]],
-                device=dev, record_cmd=True))
-        self._g2p = []
-        for k, (a, b) in enumerate(_chunks(0, model.n_particles, nt)):
-            sl = slice(a, b)
-            self._g2p.append(wp.launch(
-                g2p_kernel(dim, T), b - a,
-                inputs=[s.x[sl], s.v[sl], s.C[sl], self._grid_copies[0][1], self.dt, origin, inv_dx, dx, shape,
-                        strides, V(*model.x_lo), V(*model.x_hi), self.counts[k]],
-                device=dev, record_cmd=True))
-        # bonded weak layers: kappa replaced by its lattice-column mean after every step (kernels/bonded_camclay.py)
-        self._columns = []
-        self.column_sums = []
-        for g in model.groups:
-            if g.columns is None:
-                continue
-            kap = s.kappa[g.plastic_start:g.plastic_start + g.count]
-            col = wp.array(g.columns, dtype=wp.int32, device=dev)
-            sums = wp.zeros(g.n_columns, dtype=wp.vec2d, device=dev)
-            self.column_sums.append((col, sums))
-            self._columns += [
-                wp.launch(column_sums_zero_kernel(), g.n_columns, inputs=[sums], device=dev, record_cmd=True),
-                wp.launch(kappa_column_sum_kernel(T), g.count, inputs=[kap, col, sums], device=dev, record_cmd=True),
-                wp.launch(kappa_column_mean_kernel(T), g.count, inputs=[sums, col, kap], device=dev, record_cmd=True)]
-        self._end = wp.launch(end_step_kernel(), 1, inputs=[s.clock, s.steps], device=dev, record_cmd=True)
+        self._grid = phases.grid_update_launches(model, s, grid, self.dt, nt, seg_len, wall_point, wall_velocity,
+                                                 self.wall_impulses, self.vmax)
+        self._g2p = phases.g2p_launches(model, s, grid, self.dt, self.counts, nt)
+        self._columns, self.column_sums = phases.column_mean_launches(model, s)
+        self._end = phases.end_step_launch(model, s)
         self.use_graph = wp.get_device(dev).is_cuda if use_graph is None else use_graph
         self._graph = None
         #: steps per captured CUDA graph (the driver asks for whole batches; steps past a frame end are no-ops)

@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from ..interfaces import stack_factors
-from ..model import GRID_PADDING, lattice_counts
+from ..lattice import GRID_PADDING, lattice_counts
 from ..scenes.snow import GRAVITY
 from .interface_column import column_scenario, overburden
 

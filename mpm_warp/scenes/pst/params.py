@@ -1,8 +1,12 @@
-"""Parameters of a Propagation Saw Test and the values derived from them (functions of the parameters)."""
+"""Parameters of a Propagation Saw Test and the values derived from them (functions of the parameters).
+
+:meth:`PSTParams.validate` checks each value's range here, beside the fields (the key reference is generated
+from it); the limits that tie parameters together are in :mod:`.params_checks`. A table of an older release
+is read in today's keys by :mod:`.upgrade`.
+"""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import asdict, dataclass, field
 from typing import ClassVar, Literal
@@ -13,18 +17,13 @@ from ...checks import check_choices, finite_number, positive_int
 from ...errors import InvalidArgument
 from ...walls import WallKind
 from ..references import heierli_speed, heierli_touchdown
-from ..snow import (
-    PlaneStrain,
-    Settle,
-    Slab,
-    check_plane_strain,
-    check_weak_layer_cells,
-    oedometric_pressure,
-)
-from ..snowpack import SnowLayer, check_stack, equivalent_slab, stack_normal_stress, stack_thickness
+from ..snow import PlaneStrain, Settle, Slab, check_plane_strain, check_weak_layer_cells, oedometric_pressure
+from ..snowpack import SnowLayer, equivalent_slab, stack_normal_stress, stack_thickness
 from ..weak_layer import CalibratedWeakLayer, WeakLayer
 from .from_profile import ProfileSource
+from .params_checks import check_closure_layers, check_crack_band, check_layers, check_rigid_base
 from .saw import CutFrom, Front, Saw, SawStop
+from .upgrade import upgrade_table
 
 __all__ = ["Saw", "Front", "PSTParams", "ColumnEnds", "CutFrom", "SawStop", "upgrade_table"]
 
@@ -137,19 +136,19 @@ class PSTParams:
         check_weak_layer_cells(d_wl, dx, where)
         finite_number(f"{where}.substratum_thickness", self.substratum_thickness, lo=0.0, lo_open=True)
         for part in ("slab", "substratum"):
-            self._check_layers(part, where)
-        self._check_rigid_base(where)
+            check_layers(self, part, where)
+        check_rigid_base(self, where)
         if not self.rigid_base:
             finite_number(f"{where}.substratum_thickness (of the layers)", self.substratum_depth, lo=2.0 * dx)
         self.profile.validate(f"{where}.profile")
         if not isinstance(self.slab_fracture, bool):
             raise InvalidArgument(f"{where}.slab_fracture", self.slab_fracture, "true or false")
         if self.slab_fracture:
-            self._check_crack_band(where)
+            check_crack_band(self, where)
         if not isinstance(self.interface_closure, bool):
             raise InvalidArgument(f"{where}.interface_closure", self.interface_closure, "true or false")
         if self.interface_closure:
-            self._check_closure_layers(where)
+            check_closure_layers(self, where)
         finite_number(f"{where}.slope_angle", self.slope_angle, lo=-60.0, hi=60.0)
         finite_number(f"{where}.width", self.width, lo=0.0)
         check_plane_strain(self.plane_strain, self.width, where)
@@ -172,31 +171,6 @@ class PSTParams:
                                   "than the far end zone, one slab depth, where a front counts as at the far end")
         return self
 
-    def _check_closure_layers(self, where: str) -> None:
-        """The laminate closure smears each grid cell's compliance over layers at least a cell thick (docs/model.md
-        §5b); a thinner one diverged on a field column: refuse it."""
-        stack = [("slab", k, ly.thickness) for k, ly in enumerate(self.slab_stack())]
-        stack += [("substratum", k, ly.thickness) for k, ly in enumerate(self.substratum_stack())]
-        for part, k, t in stack:
-            if t < self.dx:
-                raise InvalidArgument(f"{where}.interface_closure", True, (
-                    f"false where a layer is thinner than a grid cell ({self.dx * 1e3:.2f} mm): {part} layer {k + 1} "
-                    f"(from the top) is {t * 1e3:.1f} mm"))
-
-    def _check_layers(self, part: str, where: str) -> None:
-        """Check ``{part}_layers``; refuse them beside a ``{part}``/``{part}_thickness`` that is not the default."""
-        layers = getattr(self, f"{part}_layers")
-        if not layers:
-            return
-        check_stack(layers, f"{where}.{part}_layers")
-        defaults = type(self).__dataclass_fields__
-        for name in (part, f"{part}_thickness"):
-            d = defaults[name]
-            default = d.default_factory() if d.default_factory is not dataclasses.MISSING else d.default
-            if getattr(self, name) != default:
-                raise InvalidArgument(f"{where}.{name}", getattr(self, name),
-                                      f"left out when {where}.{part}_layers are given (the layers define the {part})")
-
     @property
     def crack_band(self) -> float:
         """Width of the band a slab crack localises in (m): one particle spacing, ``dx / particles_per_cell``
@@ -207,30 +181,6 @@ class PSTParams:
         """The slab layers' materials, top to bottom: elastic, or cracking with ``slab_fracture``."""
         return [layer.cracking(self.crack_band) if self.slab_fracture else layer.slab().material()
                 for layer in self.slab_stack()]
-
-    def _check_rigid_base(self, where: str) -> None:
-        if not isinstance(self.rigid_base, bool):
-            raise InvalidArgument(f"{where}.rigid_base", self.rigid_base, "true or false")
-        if not self.rigid_base:
-            return
-        if self.bed != "sticky":
-            raise InvalidArgument(f"{where}.bed", self.bed, f"'sticky' with {where}.rigid_base = true (the weak "
-                                  "layer is bonded to the rigid base)")
-        default = type(self)()
-        for key in ("substratum_layers", "substratum_thickness", "substratum"):
-            if getattr(self, key) != getattr(default, key):
-                raise InvalidArgument(f"{where}.{key}", getattr(self, key), f"its default with {where}.rigid_base "
-                                      "= true (there is no substratum on a rigid base)")
-
-    def _check_crack_band(self, where: str) -> None:
-        for i, layer in enumerate(self.slab_stack()):
-            mat = layer.cracking(self.crack_band)
-            name = f"{where}.slab_layers[{i}]" if self.slab_layers else f"{where}.slab"
-            if self.crack_band >= mat.max_band_width:
-                raise InvalidArgument(f"{where}.dx", self.dx, (
-                    f"a spacing whose crack band dx/particles_per_cell stays below 2 E G_f / sigma_t^2 = "
-                    f"{mat.max_band_width:.3g} m for {name} (sigma_t {mat.tensile_strength:.4g} Pa, G_f "
-                    f"{mat.fracture_energy:.3g} J/m^2): wider, its softening snaps back"))
 
     def to_dict(self) -> dict:
         """Plain dict of the parameters (the ``[scene]`` table; the loader reads it back; ``interface_closure``
@@ -366,27 +316,3 @@ class PSTParams:
                 "heierli_touchdown": heierli_touchdown(slab.E, D, slab.density, wl.h_c),
                 "critical_cut_gaume": float(wl.critical_cut) if wl.critical_cut is not None else math.nan,
                 "rayleigh_speed": slab.rayleigh_speed, "shear_wave_speed": slab.s_wave_speed}
-
-
-def upgrade_table(table: dict) -> dict:
-    """A ``[scene]`` table of an older release in today's keys: ``saw.from_end = "left" | "right"`` (the end
-    ``x = 0`` or ``x = L``) becomes ``saw.cut_from``, the upslope or downslope end of that slope. A negative
-    slope angle must come with either: it once named the saw's end (the cut from the downslope end), now it
-    only mirrors the column."""
-    saw = table.get("saw")
-    slope = table.get("slope_angle", 0.0)
-    if isinstance(slope, (int, float)) and slope < 0.0 and not (isinstance(saw, dict) and saw.keys() & {
-            "from_end", "cut_from"}):
-        raise InvalidArgument("scene.slope_angle", slope, "given with scene.saw.cut_from = 'upslope' | 'downslope' "
-                              "when negative (before cut_from, a negative angle meant the cut from the downslope end)")
-    if isinstance(saw, dict) and "from_end" in saw:
-        end = saw.pop("from_end")
-        if "cut_from" in saw:
-            raise InvalidArgument("scene.saw.from_end", end, "left out beside scene.saw.cut_from (its older name)")
-        if end not in ("left", "right"):
-            raise InvalidArgument("scene.saw.from_end", end, "'left' or 'right' (older name of scene.saw.cut_from = "
-                                  "'upslope' | 'downslope')")
-        slope = table.get("slope_angle", 0.0)
-        up_at_origin = not isinstance(slope, (int, float)) or slope >= 0.0
-        saw["cut_from"] = "upslope" if (end == "left") == up_at_origin else "downslope"
-    return table

@@ -17,9 +17,10 @@ file's JSON that returns the Markdown lines of its tables and findings, register
         return table(["case", "speed (m/s)"], rows) + ["", env_note(data)]
 
 in the module of its part (:mod:`.perf`, :mod:`.convergence`, :mod:`.snow_runs`, :mod:`.snow_studies`,
-:mod:`.robustness`; the parts are :data:`.core.PARTS`, in that order, and within a part the sections appear
-in the order they are registered). A section goes on its part's page of :data:`.core.PAGES` unless it names
-another (``page="field_slab"``); :mod:`.pages` writes each page, its checks table first, and the index.
+:mod:`.snow_interfaces`, :mod:`.robustness`; the parts are :data:`.core.PARTS`, in that order, and within a part
+the sections appear in the order they are registered, or after the section they name as ``follows``). A
+section goes on its part's page of :data:`.core.PAGES` unless it names another (``page="field_slab"``);
+:mod:`.pages` writes each page, its checks table first, and the index.
 Format every number with :mod:`.fmt` and put the
 environment note (:func:`.fmt.env_note`) under the table. A study whose JSON is not committed yet is
 registered with :func:`.core.pending` (its section says "not measured yet" until the file appears); a file
@@ -52,6 +53,7 @@ from . import (  # noqa: F401
     perf_cuda,
     robustness,
     scaling,
+    snow_interfaces,
     snow_runs,
     snow_studies,
     snowpack,

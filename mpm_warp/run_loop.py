@@ -1,0 +1,152 @@
+"""The run loop: a simulation stepped frame by frame into its run file, with checkpoints and stops.
+
+:func:`run_frames` is :meth:`mpm_warp.simulation.Simulation.run`: it checks the times and the output,
+locks the file, writes the initial frame and checkpoint, then steps to each frame time
+(:meth:`~mpm_warp.simulation.Simulation.step_to`), checks health before every frame it writes,
+writes checkpoints at ``output.checkpoint_every`` and on a stop, stores the monitors' outcome and
+returns the :class:`~mpm_warp.result.RunResult`. Frames are written by :mod:`mpm_warp.frames`, the
+state a checkpoint holds is taken by :mod:`mpm_warp.snapshot`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time as _time
+
+import warp as wp
+
+from . import checks, frames, io
+from .errors import InvalidArgument, MPMError, SimulationBlowUp
+from .result import RunResult
+from .time_step import run_times
+
+__all__ = ["run_frames"]
+
+
+def run_frames(sim, output=None, end_time=None, frame_interval=None, callback=None, append=False,
+               overwrite=False) -> RunResult:
+    """Run ``sim`` (a :class:`~mpm_warp.simulation.Simulation`) to ``end_time`` writing a frame every
+    ``frame_interval`` (:meth:`Simulation.run <mpm_warp.simulation.Simulation.run>` says what each argument is)."""
+    output = checks.file_path("output", output, none=True)
+    end, fi = run_times(sim.scenario, end_time, frame_interval)
+    callback = checks.optional_callable("callback", callback)
+    append, overwrite = checks.flag("append", append), checks.flag("overwrite", overwrite)
+    if not append and sim.time > 0.0:
+        if output is not None:
+            raise InvalidArgument("output", output, f"None: this Simulation has run to t = {sim.time:.6g} s "
+                                  "already, and a run file starts at the initial state (make a new Simulation, "
+                                  "or mpm_warp.resume the file it wrote)")
+        if end <= sim.time * (1 + 1e-12):
+            raise InvalidArgument("end_time", end_time, f"a time after t = {sim.time:.6g} s, where this "
+                                  "Simulation stopped (a second run continues from there)")
+    if output is None:
+        return _run(sim, None, end, fi, callback, append)
+    output = io.check_output_file(output, overwrite=overwrite, append=append)
+    with io.output_lock(output):
+        try:
+            return _run(sim, output, end, fi, callback, append)
+        except io.OutOfSpace as e:   # the complete frames and the checkpoint say how to go on
+            raise frames.out_of_space(e, output) from None
+
+
+def _run(sim, output, end, fi, callback, append) -> RunResult:
+    writer = None
+    ckpt = io.checkpoint_path_for(output) if output else None
+    n_frames_total = int(math.ceil(end / fi - 1e-9))
+    if output:
+        if append:
+            # every frame is kept (restore() read them all): those after the checkpoint are stepped over
+            writer = io.RunWriter.reopen(output, verify=False)
+        else:
+            sim.run_id = frames.new_run_id()
+            writer = frames.open_writer(sim, output)
+    elif not append:
+        frames.frame_diagnostics(sim)
+    if not append:
+        sim._last_frame_time = sim.time
+    steps_total = 0
+    n_done = 0
+    wall = 0.0
+    edge0 = sim.stepper.edge_count()[0]
+    events0 = sim.stepper.deformation_events()
+    stopped = False
+    try:
+        if writer is not None and not append:
+            frames.write_frame(sim, writer)
+            _checkpoint(sim, ckpt)
+        _compile(sim)   # warm up: compile every kernel before timing
+        while sim.frame_index < n_frames_total:
+            t_next = min((sim.frame_index + 1) * fi, end)
+            t0 = _time.perf_counter()
+            steps_total += sim.step_to(t_next)
+            wp.synchronize_device(sim.device)
+            wall += _time.perf_counter() - t0
+            if sim._stop_now and sim.time < t_next * (1 - 1e-12) - 1e-15:   # stopped mid-frame
+                sim.health()
+                _checkpoint(sim, ckpt)
+                stopped = True
+                break
+            sim.frame_index += 1
+            n_done += 1
+            sim.health()  # never write a bad state into a frame or a checkpoint
+            sim._since_health = 0
+            if writer is not None:
+                if sim.frame_index < writer.n_frames:   # on file already (after the checkpoint): kept
+                    frames.frame_record(sim)
+                else:
+                    frames.write_frame(sim, writer)
+                ce = sim.scenario.output.checkpoint_every
+                if ce and sim.frame_index % ce == 0:
+                    _checkpoint(sim, ckpt)
+            else:
+                frames.frame_diagnostics(sim)
+            if (callback is not None and callback(sim, sim.frame_index) is False) or sim._stop_now:
+                if writer is not None:
+                    _checkpoint(sim, ckpt)  # a stop on request can be resumed from exactly here
+                stopped = True
+                break
+    except SimulationBlowUp as e:
+        e.output = output
+        e.checkpoint = ckpt if ckpt and io.checkpoint_is_intact(ckpt) else None
+        e.args = (str(SimulationBlowUp(e.step, e.particle, e.field, e.cause, e.checkpoint, e.output)),)
+        raise
+    finally:
+        sim._stop_now = False
+        if writer is not None:
+            try:
+                _store_outcome(sim, writer)
+            finally:
+                writer.close()
+    n = sim.model.n_particles
+    result = {}
+    for m in sim.monitors.values():
+        result.update(m.result())
+    floors, inversions = (a - b for a, b in zip(sim.stepper.deformation_events(), events0, strict=True))
+    return RunResult(output, steps_total, n_done, sim.time, wall, n * steps_total / wall if wall > 0 else 0.0,
+                     n, sim.device, sim.stepper.edge_count()[0] - edge0, result, dict(sim.monitors),
+                     floors, inversions, stopped)
+
+
+def _checkpoint(sim, path: str | None) -> None:
+    """Write the checkpoint of ``sim`` to ``path`` (none for a run without output)."""
+    if path is not None:
+        io.write_checkpoint(path, *sim.snapshot())
+
+
+def _compile(sim) -> None:
+    """Load every kernel of the plan (compiling on first use) without stepping."""
+    for m in {k.kernel.module for k in sim.stepper.launches}:
+        m.load(wp.get_device(sim.device))
+
+
+def _store_outcome(sim, writer) -> None:
+    """The monitors' ``outcome()`` records into the run file's ``outcome`` attribute (a failure there is logged:
+    the frames are safe and the result carries the outcome too)."""
+    outcomes = {n: m.outcome() for n, m in sim.monitors.items() if callable(getattr(m, "outcome", None))}
+    if not outcomes or getattr(writer, "_failed", False):
+        return
+    try:
+        writer.set_outcome(outcomes)
+    except (OSError, MPMError) as e:
+        logging.getLogger("mpm_warp").warning(f"{writer.path}: the outcome attribute was not stored ({e})")
