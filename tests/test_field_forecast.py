@@ -77,6 +77,7 @@ def test_a_forecast_that_is_not_probabilities_is_one_line():
         forecast_scores(OBS, PROB * 2)
 
 
+@pytest.mark.slow
 def test_paired_intervals_hold_the_point_values_and_a_forecast_equal_to_itself_differs_by_nothing():
     obs = ["END"] * 6 + ["SF"] * 5 + ["ARR"] * 5
     rng = np.random.default_rng(1)
@@ -139,6 +140,7 @@ def test_information_bar_never_trains_a_case_on_its_own_row_or_pit():
     assert not np.allclose(again, base)                     # other pits' models did train on it
 
 
+@pytest.mark.slow
 def test_score_records_drops_failed_runs_and_scores_every_forecast():
     recs = []
     X, obs, pits = _set(n_pits=9, per_pit=2)
