@@ -22,19 +22,11 @@ import sys
 import warnings
 
 from mpm_warp.field.batch import gather, run_records
+from mpm_warp.field.run_on import scenario_of
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
-
-
-def scenario_of(run_dir: str, case_id: str):
-    """The scenario a case ran (from its final checkpoint), or None without one."""
-    from mpm_warp.io.checkpoint import read_checkpoint_meta
-    from mpm_warp.loader import resolved_scenario
-
-    ck = os.path.join(run_dir, case_id + ".ckpt.h5")
-    return resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck) if os.path.exists(ck) else None
 
 
 def from_checkpoint(run_dir: str, case_id: str, sc) -> tuple[float | None, float | None, str | None]:

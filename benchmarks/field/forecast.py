@@ -86,8 +86,9 @@ def main(argv=None) -> int:
             p.error("DIR and --runs are needed without --quick")
         recs, selection = finished_draw(args.data, args.runs, args.per_class, args.seed)
     ok = scored(recs)
-    sc = score_records(recs)
-    probs, _ = forecasts(ok)
+    made = forecasts(ok)
+    sc = score_records(recs, probs=made)
+    probs = made[0]
     dest = out_dir(args, RESULTS, "field_forecast")
     data = {"name": "field_forecast", "environment": environment("cpu"), "selection": selection, "scores": sc,
             "cases": [{"id": r["id"], "observed": r["observed"], "predicted": r["predicted"],

@@ -21,7 +21,7 @@ import sys
 import warnings
 
 from mpm_warp.field.mechanisms import touchdown_distance
-from mpm_warp.field.run_on import run_on
+from mpm_warp.field.run_on import run_on, scenario_of
 from mpm_warp.field.scores import FIELD_CLASSES
 from mpm_warp.io.records import write_record
 from mpm_warp.studies.environment import environment, write_json
@@ -30,22 +30,13 @@ from mpm_warp.studies.protocol import out_dir, parser
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 
-def scene_of(run_dir: str, case_id: str):
-    """The PST parameters a case ran (from its checkpoint)."""
-    from mpm_warp.io.checkpoint import read_checkpoint_meta
-    from mpm_warp.loader import resolved_scenario
-
-    ck = os.path.join(run_dir, case_id + ".ckpt.h5")
-    return resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck).scene
-
-
 def one(rec: dict, run_dir: str, work: str, after: float) -> dict:
     """The landing record of the batch record ``rec`` (kept in ``work``; read back when there)."""
     path = os.path.join(work, rec["id"] + ".landing.json")
     if os.path.exists(path):
         with open(path) as fh:
             return json.load(fh)
-    p = scene_of(run_dir, rec["id"])
+    p = scenario_of(run_dir, rec["id"]).scene
     out = {k: rec.get(k) for k in ("id", "test", "observed", "predicted", "slab_depth", "slab_density")}
     out.update(touchdown_distance=touchdown_distance(p), column_m=float(p.length))
     try:

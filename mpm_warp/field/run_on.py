@@ -20,7 +20,17 @@ import numpy as np
 
 from ..io import checkpoint_path_for, read_run
 
-__all__ = ["run_on"]
+__all__ = ["run_on", "scenario_of"]
+
+
+def scenario_of(run_dir: str, case_id: str):
+    """The scenario the case ``case_id`` of the runs folder ``run_dir`` ran (from its final checkpoint), or None
+    without one."""
+    from ..io.checkpoint import read_checkpoint_meta
+    from ..loader import resolved_scenario
+
+    ck = os.path.join(run_dir, case_id + ".ckpt.h5")
+    return resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck) if os.path.exists(ck) else None
 
 
 def _peak(x) -> float | None:

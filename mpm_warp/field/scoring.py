@@ -77,7 +77,7 @@ def forecasts(recs: list, *, info_repeats: int = 20) -> tuple[dict, dict]:
     return out, why
 
 
-def score_records(recs: list, *, resamples: int = 2000) -> dict:
+def score_records(recs: list, *, resamples: int = 2000, probs: tuple[dict, dict] | None = None) -> dict:
     """Scores of the model and of the references on the scored records (module docstring).
 
     Returns
@@ -86,13 +86,14 @@ def score_records(recs: list, *, resamples: int = 2000) -> dict:
         ``cases``, ``failed``; per class predictor (``model``, ``majority``, ``weac_static``) its
         :func:`~.scores.scores`; ``uncertainty`` (balanced accuracies); ``forecast`` {name: :func:`~.forecast.
         forecast_scores`}, ``forecast_missing`` {name: why}, ``forecast_uncertainty`` (paired intervals against the
-        model, when it has a forecast); the wall times.
+        model, when it has a forecast); the wall times. ``probs``: :func:`forecasts` of the scored records, when
+        the caller has it already.
     """
     ok = scored(recs)
     obs = [r["observed"] for r in ok]
     pred = {"model": [r["predicted"] for r in ok], "majority": baseline_majority(obs),
             "weac_static": [r.get("static_class") or "none" for r in ok]}
-    probs, missing = forecasts(ok) if ok else ({}, {"model": "no case was scored"})
+    probs, missing = probs or (forecasts(ok) if ok else ({}, {"model": "no case was scored"}))
     out = {"cases": len(ok), "failed": sum(r.get("status") != "ok" for r in recs),
            **{name: scores(obs, p) for name, p in pred.items()},
            "uncertainty": balanced_accuracy_intervals(obs, pred, reference="model"),
