@@ -21,7 +21,7 @@ from .errors import InvalidArgument, MPMError, SimulationBlowUp
 from .result import RunResult
 from .time_step import run_times
 
-__all__ = ["run_frames"]
+__all__ = ["run_frames", "FrameRun"]
 
 
 def run_frames(sim, output=None, end_time=None, frame_interval=None, callback=None, append=False,
@@ -51,81 +51,129 @@ def run_frames(sim, output=None, end_time=None, frame_interval=None, callback=No
 
 
 def _run(sim, output, end, fi, callback, append) -> RunResult:
-    writer = None
-    ckpt = io.checkpoint_path_for(output) if output else None
-    n_frames_total = int(math.ceil(end / fi - 1e-9))
-    if output:
-        if append:
-            # every frame is kept (restore() read them all): those after the checkpoint are stepped over
-            writer = io.RunWriter.reopen(output, verify=False)
-        else:
-            sim.run_id = frames.new_run_id()
-            writer = frames.open_writer(sim, output)
-    elif not append:
-        frames.frame_diagnostics(sim)
-    if not append:
-        sim._last_frame_time = sim.time
-    steps_total = 0
-    n_done = 0
-    wall = 0.0
-    edge0 = sim.stepper.edge_count()[0]
-    events0 = sim.stepper.deformation_events()
-    stopped = False
+    frames_ = FrameRun(sim, output, end, fi, callback, append)
     try:
-        if writer is not None and not append:
-            frames.write_frame(sim, writer)
-            _checkpoint(sim, ckpt)
-        _compile(sim)   # warm up: compile every kernel before timing
-        while sim.frame_index < n_frames_total:
-            t_next = min((sim.frame_index + 1) * fi, end)
+        frames_.open()
+        while frames_.running:
             t0 = _time.perf_counter()
-            steps_total += sim.step_to(t_next)
+            steps = sim.step_to(frames_.next_time)
             wp.synchronize_device(sim.device)
-            wall += _time.perf_counter() - t0
-            if sim._stop_now and sim.time < t_next * (1 - 1e-12) - 1e-15:   # stopped mid-frame
-                sim.health()
-                _checkpoint(sim, ckpt)
-                stopped = True
-                break
-            sim.frame_index += 1
-            n_done += 1
-            sim.health()  # never write a bad state into a frame or a checkpoint
-            sim._since_health = 0
-            if writer is not None:
-                if sim.frame_index < writer.n_frames:   # on file already (after the checkpoint): kept
-                    frames.frame_record(sim)
-                else:
-                    frames.write_frame(sim, writer)
-                ce = sim.scenario.output.checkpoint_every
-                if ce and sim.frame_index % ce == 0:
-                    _checkpoint(sim, ckpt)
-            else:
-                frames.frame_diagnostics(sim)
-            if (callback is not None and callback(sim, sim.frame_index) is False) or sim._stop_now:
-                if writer is not None:
-                    _checkpoint(sim, ckpt)  # a stop on request can be resumed from exactly here
-                stopped = True
-                break
+            frames_.reached(steps, _time.perf_counter() - t0)
     except SimulationBlowUp as e:
-        e.output = output
-        e.checkpoint = ckpt if ckpt and io.checkpoint_is_intact(ckpt) else None
-        e.args = (str(SimulationBlowUp(e.step, e.particle, e.field, e.cause, e.checkpoint, e.output)),)
+        frames_.blew_up(e)
         raise
     finally:
-        sim._stop_now = False
+        frames_.close()
+    return frames_.result()
+
+
+class FrameRun:
+    """One simulation's frames, checkpoints, stops and result, however it is stepped: by its own
+    :meth:`~mpm_warp.simulation.Simulation.step_to` (:func:`run_frames`) or beside other columns
+    (:mod:`mpm_warp.column_batch`).
+
+    :meth:`open` writes the initial frame and checkpoint; after each stepping to :attr:`next_time`,
+    :meth:`reached` checks health, writes the frame and asks the callback; :meth:`close` stores the
+    monitors' outcome and closes the file; :meth:`result` is the run's :class:`~mpm_warp.result.RunResult`.
+    """
+
+    def __init__(self, sim, output, end: float, fi: float, callback, append: bool):
+        self.sim, self.output, self.end, self.fi, self.callback, self.append = sim, output, end, fi, callback, append
+        self.writer = None
+        self.ckpt = io.checkpoint_path_for(output) if output else None
+        self.n_frames_total = int(math.ceil(end / fi - 1e-9))
+        self.steps_total, self.n_done, self.wall, self.stopped = 0, 0, 0.0, False
+        self._edge0 = sim.stepper.edge_count()[0]
+        self._events0 = sim.stepper.deformation_events()
+
+    @property
+    def next_time(self) -> float:
+        """The time of the next frame (s)."""
+        return min((self.sim.frame_index + 1) * self.fi, self.end)
+
+    @property
+    def running(self) -> bool:
+        """Whether frames remain and nothing has stopped the run."""
+        return not self.stopped and self.sim.frame_index < self.n_frames_total
+
+    def open(self) -> None:
+        """The run file (new, or reopened to append), its initial frame and checkpoint; every kernel compiled."""
+        sim, output = self.sim, self.output
+        if output:
+            if self.append:
+                # every frame is kept (restore() read them all): those after the checkpoint are stepped over
+                self.writer = io.RunWriter.reopen(output, verify=False)
+            else:
+                sim.run_id = frames.new_run_id()
+                self.writer = frames.open_writer(sim, output)
+        elif not self.append:
+            frames.frame_diagnostics(sim)
+        if not self.append:
+            sim._last_frame_time = sim.time
+        if self.writer is not None and not self.append:
+            frames.write_frame(sim, self.writer)
+            _checkpoint(sim, self.ckpt)
+        _compile(sim)   # warm up: compile every kernel before timing
+
+    def reached(self, steps: int, wall: float) -> None:
+        """After ``steps`` steps (``wall`` s) towards :attr:`next_time`: the frame (health checked first),
+        the checkpoint it is due, and the callback; a stop on request mid-frame checkpoints where it is."""
+        sim, writer = self.sim, self.writer
+        t_next = self.next_time
+        self.steps_total += steps
+        self.wall += wall
+        if sim._stop_now and sim.time < t_next * (1 - 1e-12) - 1e-15:   # stopped mid-frame
+            sim.health()
+            _checkpoint(sim, self.ckpt)
+            self.stopped = True
+            return
+        sim.frame_index += 1
+        self.n_done += 1
+        sim.health()  # never write a bad state into a frame or a checkpoint
+        sim._since_health = 0
         if writer is not None:
+            if sim.frame_index < writer.n_frames:   # on file already (after the checkpoint): kept
+                frames.frame_record(sim)
+            else:
+                frames.write_frame(sim, writer)
+            ce = sim.scenario.output.checkpoint_every
+            if ce and sim.frame_index % ce == 0:
+                _checkpoint(sim, self.ckpt)
+        else:
+            frames.frame_diagnostics(sim)
+        if (self.callback is not None and self.callback(sim, sim.frame_index) is False) or sim._stop_now:
+            if writer is not None:
+                _checkpoint(sim, self.ckpt)  # a stop on request can be resumed from exactly here
+            self.stopped = True
+
+    def blew_up(self, e: SimulationBlowUp) -> None:
+        """Name the run file and its last intact checkpoint in the blow-up ``e``."""
+        e.output = self.output
+        e.checkpoint = self.ckpt if self.ckpt and io.checkpoint_is_intact(self.ckpt) else None
+        e.args = (str(SimulationBlowUp(e.step, e.particle, e.field, e.cause, e.checkpoint, e.output)),)
+
+    def close(self) -> None:
+        """The monitors' outcome into the run file, and the file closed (also after an error)."""
+        self.sim._stop_now = False
+        if self.writer is not None:
             try:
-                _store_outcome(sim, writer)
+                _store_outcome(self.sim, self.writer)
             finally:
-                writer.close()
-    n = sim.model.n_particles
-    result = {}
-    for m in sim.monitors.values():
-        result.update(m.result())
-    floors, inversions = (a - b for a, b in zip(sim.stepper.deformation_events(), events0, strict=True))
-    return RunResult(output, steps_total, n_done, sim.time, wall, n * steps_total / wall if wall > 0 else 0.0,
-                     n, sim.device, sim.stepper.edge_count()[0] - edge0, result, dict(sim.monitors),
-                     floors, inversions, stopped)
+                self.writer.close()
+                self.writer = None
+
+    def result(self) -> RunResult:
+        """What the run did (:class:`~mpm_warp.result.RunResult`)."""
+        sim = self.sim
+        n = sim.model.n_particles
+        result = {}
+        for m in sim.monitors.values():
+            result.update(m.result())
+        floors, inversions = (a - b for a, b in zip(sim.stepper.deformation_events(), self._events0, strict=True))
+        rate = n * self.steps_total / self.wall if self.wall > 0 else 0.0
+        return RunResult(self.output, self.steps_total, self.n_done, sim.time, self.wall, rate, n, sim.device,
+                         sim.stepper.edge_count()[0] - self._edge0, result, dict(sim.monitors), floors, inversions,
+                         self.stopped)
 
 
 def _checkpoint(sim, path: str | None) -> None:
