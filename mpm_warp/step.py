@@ -23,6 +23,7 @@ import numpy as np
 import warp as wp
 
 from . import step_phases as phases
+from .errors import InvalidArgument
 from .kernels.fpmode import flush_kernels
 from .kernels.types import vec
 from .meeting import MeetingPoint
@@ -221,6 +222,27 @@ class Stepper:
 
     def _launch_step(self) -> None:
         self._team_steps(1)
+
+    # ------------------------------------------------- a step in two parts, for columns stepped together
+    def choose_step(self) -> None:
+        """The first part of a one-thread step: the step size, chosen as by :meth:`steps` (into the clock)."""
+        self._begin.launch()
+
+    def finish_step(self) -> None:
+        """The rest of a one-thread step with the step size now in the clock (:mod:`mpm_warp.column_batch` sets
+        one for many columns between the two parts): walls, actions, closure, P2G, grid, G2P, clock."""
+        if self.n_threads != 1:
+            raise InvalidArgument("n_threads", self.n_threads, "1 for a column stepped with others")
+        if self._wall_state is not None:
+            self._wall_state.launch()
+        for a in self.actions:
+            a.launch()
+        for launch in self._closure:
+            launch.launch()
+        self._scatter(0)
+        self._grid[0].launch()
+        self._g2p[0].launch()
+        self._after_gather()
 
     def profile(self, n: int) -> dict:
         """Wall seconds per step of each stage over ``n`` steps, on every thread (the CPU step's cost breakdown).
