@@ -16,6 +16,8 @@ DESCRIPTION = (
     "every refused record is also one line on the terminal, and Dask's logs go to dask.log there (--verbose: to the "
     "terminal).")
 EXAMPLE = "example: mpm-warp field pits/ --out field-run --workers 2"
+#: columns stepped together on a GPU unless --columns says otherwise: one field column leaves a GPU idle
+GPU_COLUMNS = 64
 
 
 def cmd_field(a) -> int:
@@ -23,10 +25,13 @@ def cmd_field(a) -> int:
     from .field.batch import run_field
     from .field.protocol import FieldProtocol
 
-    res = run_field(a.inputs, a.out, workers=a.workers, scheduler=a.scheduler, device=a.device, limit=a.limit,
+    on_gpu = str(a.device).startswith("cuda")
+    columns = a.columns if a.columns is not None else (GPU_COLUMNS if on_gpu else 1)
+    workers = a.workers if a.workers is not None or not on_gpu else 1
+    res = run_field(a.inputs, a.out, workers=workers, scheduler=a.scheduler, device=a.device, limit=a.limit,
                     protocol=FieldProtocol(max_particles=a.max_particles, threads=a.threads,
                                            rigid_base=not a.elastic_substratum, pre_cut_share=a.pre_cut_share,
-                                           interface_closure=a.interface_closure),
+                                           interface_closure=a.interface_closure, columns=columns),
                     progress=not a.quiet, verbose=a.verbose)
     sc = res.scores
     for r in res.refused:
@@ -53,7 +58,8 @@ def add_field(sub) -> None:
                        description=DESCRIPTION, epilog=EXAMPLE)
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="folder of CAAML files, a CAAML file, or a CSV table")
     p.add_argument("--out", required=True, help="folder of the runs and results (an earlier batch's cases are kept)")
-    p.add_argument("--workers", type=int, help="workers of the local cluster (default: the cores over --threads)")
+    p.add_argument("--workers", type=int, help="workers of the local cluster (default: the cores over --threads; "
+                   "1 on a GPU)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--device", default="cpu", help="cpu | cuda | cuda:N (default cpu)")
     p.add_argument("--limit", type=int, help="run only the first N runnable cases")
@@ -61,6 +67,9 @@ def add_field(sub) -> None:
                    help=f"per-case budget: most particles of a column (default {FieldProtocol.max_particles:,})")
     p.add_argument("--threads", type=int, default=FieldProtocol.threads,
                    help="CPU threads of each case's step (default 1); workers x threads should not exceed the cores")
+    p.add_argument("--columns", type=int, metavar="N",
+                   help=f"columns stepped together in one task, with one step size, each on one thread (default "
+                        f"{GPU_COLUMNS} on a GPU, 1 on the CPU: each case alone)")
     p.add_argument("--elastic-substratum", action="store_true",
                    help="run the weak layer on the profile's old snow instead of a rigid base (weac's column)")
     p.add_argument("--pre-cut-share", type=float, default=FieldProtocol.pre_cut_share, metavar="SHARE",

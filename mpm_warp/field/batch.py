@@ -29,19 +29,17 @@ import json
 import os
 import re
 import sys
-import time
-import traceback
 import uuid
 from dataclasses import dataclass
 
 from .. import io
 from ..errors import InvalidArgument
 from .batch_setup import Progress, check_out_dir, check_scheduler, dask_client, dask_log, iter_gather
+from .case_run import column_step, run_case, run_case_group, write_case_record
 from .cases import FieldCase, FieldRefusal
 from .information_bar import CASE_FEATURES, case_record_features
 from .plain_words import in_field_terms
-from .probability import outcome_probability
-from .protocol import FieldProtocol, decided, protocol_params
+from .protocol import FieldProtocol, protocol_params
 from .scores import field_class
 from .scoring import score_records
 from .static_rule import weac_static_rule
@@ -93,49 +91,7 @@ def _case_id(case: FieldCase, k: int, proto: FieldProtocol) -> str:
 
 
 def _write_json(path: str, obj: dict) -> None:
-    io.write_record(path, obj, "a field case record", default=str)
-
-
-def _finite(x):
-    return x if isinstance(x, (int, float)) and x == x and abs(x) != float("inf") else None
-
-
-def run_case(task: dict) -> dict:
-    """One case in a worker (never raises: a failure is a record with its error)."""
-    from ..runner import run
-
-    t0 = time.perf_counter()
-    out = os.path.join(task["out_dir"], task["id"])
-    rec = {k: task[k] for k in ("id", "pit", "test", "observed", "recorded_cut", "static_class", "static_peak_ratio",
-                                 "w_f", "w_f_source", "setup", *CASE_FEATURES)}
-    rec["status"] = "failed"
-    used = {}
-
-    def until_decided(sim, frame):
-        used["threads"] = sim.stepper.n_threads        # the threads the step really ran on
-        return not decided(sim)
-
-    try:
-        res = run(task["scenario"], out + ".part.h5", device=task["device"], overwrite=True,
-                  n_threads=task.get("threads"), callback=until_decided)
-        o = res.scene_result.get("outcome", {})
-        rec.update(status="ok", predicted=o.get("class") or "running", field_line=o.get("field_line"),
-                   runaway_cut=_finite(res.scene_result.get("runaway_cut")),
-                   slab_fracture_at=_finite(o.get("slab_fracture_at")), note=o.get("note", ""),
-                   slab_peak_stress_ratio=_finite(o.get("slab_peak_stress_ratio")),
-                   sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
-                   threads=used.get("threads"), workers=task.get("workers"),
-                   n_frames=io.read_run(out + ".part.h5").n_frames)
-        prob = outcome_probability(rec["predicted"], rec["slab_peak_stress_ratio"])
-        if prob is not None:
-            rec["p_end"], rec["p_sf"], rec["p_arr"] = prob
-        io.promote_part(out)
-        rec["run_file"] = os.path.basename(out + ".h5")
-    except Exception as e:      # a failing case is recorded with its error; it never stops the batch
-        rec.update(status="failed", error=f"{type(e).__name__}: {e}", traceback=traceback.format_exc(limit=-4))
-    rec["case_wall_s"] = time.perf_counter() - t0
-    _write_json(out + ".json", rec)
-    return rec
+    write_case_record(path, obj)
 
 
 def _finished(task: dict) -> dict | None:
@@ -213,14 +169,18 @@ def _tasks(cases, out_dir, proto, device, refused) -> list[dict]:
     return [t for t in tasks if t is not None]
 
 
-def _execute(todo, records, workers, scheduler, progress: Progress, threads=1, out_dir=".", verbose=False) -> None:
+def _execute(todo, records, workers, scheduler, progress: Progress, threads=1, out_dir=".", verbose=False,
+             columns: int = 1) -> None:
     """Run the tasks of the iterator ``todo`` as they come (each submitted once set up, so the first case starts
-    while the later rows are set up) and put their records in ``records``; no cluster where there is none."""
+    while the later rows are set up) and put their records in ``records``; no cluster where there is none. With
+    ``columns`` > 1 the tasks go in groups of that many columns stepped together (:func:`column_groups`)."""
     from distributed import as_completed
 
     first = next(todo, None)
     if first is None:
         return
+    groups = column_groups(itertools.chain([first], todo), columns) if columns > 1 else ([t] for t in
+                                                                                        itertools.chain([first], todo))
     with contextlib.ExitStack() as stack:
         terminal = stack.enter_context(dask_log(out_dir, verbose))
         if progress.stream is sys.stderr:
@@ -230,21 +190,25 @@ def _execute(todo, records, workers, scheduler, progress: Progress, threads=1, o
         token, futures, running = uuid.uuid4().hex[:8], {}, as_completed()
 
         def collect(fut):
-            task = futures.pop(fut)
+            group = futures.pop(fut)
             try:
-                rec = fut.result()
+                recs = fut.result()
+                recs = recs if isinstance(recs, list) else [recs]
             except Exception as e:   # the worker died too often, or the cluster is gone
-                rec = {"id": task["id"], "status": "failed", "error": f"{type(e).__name__}: {e}"}
-                _write_json(os.path.join(task["out_dir"], task["id"] + ".json"), rec)
+                recs = [{"id": t["id"], "status": "failed", "error": f"{type(e).__name__}: {e}"} for t in group]
+                for t, rec in zip(group, recs, strict=True):
+                    _write_json(os.path.join(t["out_dir"], t["id"] + ".json"), rec)
             fut.release()
-            records[task["id"]] = rec
-            progress.done += 1
+            for rec in recs:
+                records[rec["id"]] = rec
+                progress.done += 1
             progress.show()
 
-        for i, t in enumerate(itertools.chain([first], todo)):
-            t = {**t, "workers": n_workers}    # each record says how many cases ran beside it
-            fut = client.submit(run_case, t, key=f"{t['id']}-{token}", retries=1, pure=False, priority=-i)
-            futures[fut] = t
+        for i, group in enumerate(groups):
+            group = [{**t, "workers": n_workers} for t in group]    # each record says how many cases ran beside it
+            run, arg = (run_case, group[0]) if columns == 1 else (run_case_group, group)
+            fut = client.submit(run, arg, key=f"{group[0]['id']}-{token}", retries=1, pure=False, priority=-i)
+            futures[fut] = group
             running.add(fut)
             while running.has_ready():
                 collect(next(running))
@@ -252,6 +216,18 @@ def _execute(todo, records, workers, scheduler, progress: Progress, threads=1, o
         for fut in running:
             collect(fut)
         progress.stream = sys.stderr if progress.stream is terminal else progress.stream
+
+
+def column_groups(tasks, columns: int, window: int = 4):
+    """Groups of up to ``columns`` tasks from the iterator ``tasks``, for columns stepped together: each
+    ``window`` groups' worth of tasks is sorted by the column's own elastic step (:func:`column_step`), so that
+    a group's columns step at similar sizes and the shared step costs the others little."""
+    batch = list(itertools.islice(tasks, columns * window))
+    while batch:
+        batch.sort(key=lambda t: column_step(t["scenario"]))
+        for k in range(0, len(batch), columns):
+            yield batch[k:k + columns]
+        batch = list(itertools.islice(tasks, columns * window))
 
 
 def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
@@ -357,7 +333,7 @@ def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Pro
                 progress.done += 1
             progress.show()
 
-    _execute(todo(), records, workers, scheduler, progress, proto.threads, out_dir, verbose)
+    _execute(todo(), records, workers, scheduler, progress, proto.threads, out_dir, verbose, proto.columns)
     progress.refused = len(refused)
     progress.end()
     recs = [records[t["id"]] for t in done]

@@ -58,6 +58,11 @@ class FieldProtocol:
         CPU threads each case's step runs on (the CPU step's own threads; ignored on CUDA). A batch's workers
         times this should not exceed the cores: on 2 cores, 1 worker of 2 threads finishes each case sooner
         (the median case's wall time), 2 workers of 1 thread finish more cases an hour.
+    columns : int
+        Columns stepped together in one task (:mod:`mpm_warp.column_batch`), each on one thread, with one step
+        size: the least of theirs. 1 (the default): each case alone. Many columns fill a GPU that one column
+        leaves idle; a column then steps at most as long as alone, and its key (so its id) says it shares its
+        step: a case's numbers then depend on its group's stiffest column, within the step's discretisation error.
     """
 
     max_particles: int = 120_000
@@ -69,6 +74,7 @@ class FieldProtocol:
     pre_cut_share: float = 0.5
     interface_closure: bool = False
     threads: int = 1
+    columns: int = 1
 
     def validate(self) -> FieldProtocol:
         """Check every value (one-line InvalidArgument naming it); return self."""
@@ -80,6 +86,7 @@ class FieldProtocol:
         finite_number("tail", self.tail, lo=0.0)
         finite_number("frame_interval", self.frame_interval, lo=0.0, lo_open=True, hi=0.1)
         positive_int("threads", self.threads, lo=1, hi=64)
+        positive_int("columns", self.columns, lo=1, hi=4096)
         for name in ("rigid_base", "interface_closure"):
             if not isinstance(getattr(self, name), bool):
                 raise InvalidArgument(name, getattr(self, name), "true or false")
@@ -88,12 +95,14 @@ class FieldProtocol:
 
     def run_key(self) -> dict:
         """The fields that change what a case computes (all but ``threads``): a cached case is reused only under
-        the same ones. ``interface_closure`` is left out while off, so that the cases run before it existed keep
-        their keys."""
+        the same ones. ``interface_closure`` is left out while off, and ``columns`` while 1, so that the cases
+        run before they existed keep their keys."""
         d = dataclasses.asdict(self)
         del d["threads"]
         if not self.interface_closure:
             del d["interface_closure"]
+        if self.columns == 1:
+            del d["columns"]
         return d
 
 
