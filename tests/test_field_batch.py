@@ -202,14 +202,14 @@ def test_a_protocol_with_a_pre_cut_starts_each_column_sawn_a_share_of_weacs_crit
 
 def test_the_pre_cut_is_measured_on_weacs_critical_cut_of_the_column(tmp_path):
     """The cut at which weac's energy release rate of the column reaches the case's fracture energy."""
-    from mpm_warp.field.batch import _static_cut
+    from mpm_warp.field.static_view import static_view
     from mpm_warp.scenes.pst.static import static_column
     from mpm_warp.scenes.weac_reference import energy_release_rate
 
     table = tmp_path / "psts.csv"
     table.write_text(TABLE)
     cases, _ = gather([str(table)], calibrate=False)
-    a = _static_cut(cases[0])
+    a = static_view(cases[0].params).critical_cut
     assert 0.0 < a < 0.4
     assert energy_release_rate(static_column(cases[0].params), a)[0] == pytest.approx(0.3, rel=0.02)   # w_f given
 
