@@ -41,7 +41,7 @@ from .cases import FieldCase, FieldRefusal
 from .information_bar import CASE_FEATURES, case_record_features
 from .plain_words import in_field_terms
 from .probability import outcome_probability
-from .protocol import FieldProtocol, decided, protocol_params
+from .protocol import FieldProtocol, protocol_params, run_to_decision
 from .scores import field_class
 from .scoring import score_records
 from .static_view import static_view
@@ -102,29 +102,21 @@ def _finite(x):
 
 def run_case(task: dict) -> dict:
     """One case in a worker (never raises: a failure is a record with its error)."""
-    from ..runner import run
-
     t0 = time.perf_counter()
     out = os.path.join(task["out_dir"], task["id"])
     rec = {k: task[k] for k in ("id", "pit", "test", "observed", "recorded_cut", "static_class", "static_peak_ratio",
                                  "w_f", "w_f_source", "setup", *CASE_FEATURES)}
     rec["status"] = "failed"
-    used = {}
-
-    def until_decided(sim, frame):
-        used["threads"] = sim.stepper.n_threads        # the threads the step really ran on
-        return not decided(sim)
-
     try:
-        res = run(task["scenario"], out + ".part.h5", device=task["device"], overwrite=True,
-                  n_threads=task.get("threads"), callback=until_decided)
+        res, threads = run_to_decision(task["scenario"], out + ".part.h5", device=task["device"],
+                                       n_threads=task.get("threads"))
         o = res.scene_result.get("outcome", {})
         rec.update(status="ok", predicted=o.get("class") or "running", field_line=o.get("field_line"),
                    runaway_cut=_finite(res.scene_result.get("runaway_cut")),
                    slab_fracture_at=_finite(o.get("slab_fracture_at")), note=o.get("note", ""),
                    slab_peak_stress_ratio=_finite(o.get("slab_peak_stress_ratio")),
                    sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
-                   threads=used.get("threads"), workers=task.get("workers"),
+                   threads=threads, workers=task.get("workers"),
                    n_frames=io.read_run(out + ".part.h5").n_frames)
         prob = outcome_probability(rec["predicted"], rec["slab_peak_stress_ratio"])
         if prob is not None:
