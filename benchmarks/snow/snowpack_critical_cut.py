@@ -35,6 +35,7 @@ from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.snowpack import SnowLayer
 from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parse_cases, parser
 from mpm_warp.studies.snow import ladder_pst
 
@@ -101,10 +102,7 @@ def derived(cases: dict) -> dict:
 
 
 def figure(data: dict, path: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     cases = data["cases"]
     fig, ax = plt.subplots(figsize=(9, 1.9 + 0.5 * len(cases)))
@@ -121,9 +119,7 @@ def figure(data: dict, path: str) -> None:
                ax.plot([], [], "*", color="C2", ms=11, mfc="none")[0]]
     ax.legend(handles, ["arrested", "propagated", "bracket", "weac (energy criterion, G = w_f)"], loc="upper center",
               bbox_to_anchor=(0.5, -0.16), ncols=4, fontsize=8, frameon=False)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def load(folder: str) -> dict:
