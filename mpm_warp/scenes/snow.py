@@ -41,8 +41,12 @@ class Slab:
 
     Attributes
     ----------
-    E, nu, density : float
-        The slab's elasticity and mass, as :class:`~mpm_warp.materials.Elastic` takes them (Pa, -, kg/m^3).
+    E : float
+        Young's modulus (Pa), > 0.
+    nu : float
+        Poisson's ratio (-), in [0, 0.5).
+    density : float
+        Density (kg/m^3), > 0.
     tensile_strength, fracture_energy : float
         Of a slab that can break (Pa, J/m^2), >= 0; 0 = from the density (``scene.slab_fracture``; see
         :class:`~mpm_warp.scenes.snowpack.SnowLayer`). Unused for the substratum.
