@@ -62,6 +62,22 @@ def grid_after_one_step(sim: mw.Simulation):
     return x, m, v
 
 
+def apic_momenta(sim: mw.Simulation):
+    """Linear (kg m/s) and angular momentum (kg m^2/s, about the origin) of the first material group's particles,
+    in float64, the angular one with APIC's spin term ``m D (C - C^T)``, ``D = dx^2 / 4`` (quadratic B-splines):
+    a scalar (about z) in 2D, a vector in 3D."""
+    m = sim.model.groups[0].mass
+    x = sim.state.x.numpy().astype(np.float64)
+    v = sim.state.v.numpy().astype(np.float64)
+    C = sim.state.C.numpy().astype(np.float64)
+    D = sim.model.dx ** 2 / 4.0
+    P = m * v.sum(axis=0)
+    if x.shape[1] == 2:
+        return P, m * (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]).sum() + m * D * (C[:, 1, 0] - C[:, 0, 1]).sum()
+    spin = np.stack([C[:, 2, 1] - C[:, 1, 2], C[:, 0, 2] - C[:, 2, 0], C[:, 1, 0] - C[:, 0, 1]], axis=1)
+    return P, m * np.cross(x, v).sum(axis=0) + m * D * spin.sum(axis=0)
+
+
 # ------------------------------------------------------------------- set-ups
 def block_on_floor(*, kind: str, friction: float = 0.0, gravity=(0.0, -9.81, 0.0), gravity_ramp: float = 0.0,
                    velocity=(0.0, 0.0, 0.0), floor_velocity=(0.0, 0.0, 0.0), floor_ramp: float = 0.0,

@@ -140,30 +140,17 @@ def _case_max_memory(made, tmp):
     return ["run", str(made / "scene.toml"), "--max-memory", "50k"], ("domain.dx", "available (max_memory)")
 
 
-def _case_render_out_missing(made, tmp):
-    return ["render", str(made / "run.h5"), "--out", str(tmp / "missing" / "frames")], ("does not exist",)
-
-
-def _case_render_out_file(made, tmp):
-    (tmp / "f").write_text("x")
-    return ["render", str(made / "run.h5"), "--out", str(tmp / "f")], ("not a folder",)
-
-
-def _case_render_out_read_only(made, tmp):
-    return ["render", str(made / "run.h5"), "--out", _read_only_dir(tmp) + "/frames"], ("not writable",)
-
-
-def _case_plot_out_missing(made, tmp):
-    return ["plot", str(made / "run.h5"), "--out", str(tmp / "missing" / "plots")], ("does not exist",)
-
-
-def _case_plot_out_file(made, tmp):
-    (tmp / "f").write_text("x")
-    return ["plot", str(made / "run.h5"), "--out", str(tmp / "f")], ("not a folder",)
-
-
-def _case_plot_out_read_only(made, tmp):
-    return ["plot", str(made / "run.h5"), "--out", _read_only_dir(tmp) + "/plots"], ("not writable",)
+def _out_folder(command, how):
+    """``command``'s ``--out`` folder (render: frames, plot: plots) missing, a file, or in a read-only folder."""
+    def case(made, tmp):
+        name = "frames" if command == "render" else "plots"
+        if how == "is-file":
+            (tmp / "f").write_text("x")
+        out = {"missing-folder": str(tmp / "missing" / name), "is-file": str(tmp / "f"),
+               "read-only": _read_only_dir(tmp) + "/" + name}[how]
+        why = {"missing-folder": "does not exist", "is-file": "not a folder", "read-only": "not writable"}[how]
+        return [command, str(made / "run.h5"), "--out", out], (why,)
+    return case
 
 
 def _case_resume_end_before(made, tmp):
@@ -205,9 +192,8 @@ FILE_CASES = [
     ("out-exists", _case_out_exists), ("out-is-the-scenario", _case_out_is_scenario), ("out-fifo", _case_out_fifo),
     ("out-dev-null", _case_out_dev_null), ("memory-40m-domain", _case_memory_domain),
     ("memory-1.5e10-particles", _case_memory_particles), ("max-memory", _case_max_memory),
-    ("render-out-missing-folder", _case_render_out_missing), ("render-out-is-file", _case_render_out_file),
-    ("render-out-read-only", _case_render_out_read_only), ("plot-out-missing-folder", _case_plot_out_missing),
-    ("plot-out-is-file", _case_plot_out_file), ("plot-out-read-only", _case_plot_out_read_only),
+    *((f"{cmd}-out-{how}", _out_folder(cmd, how)) for cmd in ("render", "plot")
+      for how in ("missing-folder", "is-file", "read-only")),
     ("resume-end-before-checkpoint", _case_resume_end_before),
     ("resume-corrupt-checkpoint", _case_resume_corrupt_checkpoint),
 ] + [(f"{cmd}-{how}-run-file", _damaged(cmd, how)) for cmd in ("plot", "render", "resume")

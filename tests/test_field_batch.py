@@ -20,6 +20,14 @@ no-slope,End,,100,30,30,200,3,,,
 """
 
 
+@pytest.fixture
+def cases(tmp_path):
+    """The cases of :data:`TABLE`, set up without calibrating (a test of the set-up and the protocol runs none)."""
+    table = tmp_path / "psts.csv"
+    table.write_text(TABLE)
+    return gather([str(table)], calibrate=False)[0]
+
+
 def test_recall_balanced_accuracy_and_the_majority_baseline():
     obs = ["END"] * 6 + ["SF"] * 2 + ["ARR"] * 2
     pred = ["END"] * 5 + ["SF"] + ["END", "SF"] + ["ARR", "NP"]
@@ -141,15 +149,12 @@ def test_the_bootstrap_intervals_of_a_balanced_accuracy():
         balanced_accuracy_intervals(obs, {"model": half}, reference="x")
 
 
-def test_the_protocol_runs_the_weak_layer_on_a_rigid_base_and_keys_its_cache_by_it(tmp_path):
+def test_the_protocol_runs_the_weak_layer_on_a_rigid_base_and_keys_its_cache_by_it(cases):
     """weac reads the fracture energy back on a rigid base; the run uses the same column unless asked not to, and a
     batch's cached cases are reused only under the protocol that ran them (threads aside)."""
     from mpm_warp.field.batch import _case_id
     from mpm_warp.field.protocol import protocol_params
 
-    table = tmp_path / "psts.csv"
-    table.write_text(TABLE)
-    cases, _ = gather([str(table)], calibrate=False)
     rigid, _, note = protocol_params(cases[0].params, FieldProtocol())
     assert rigid.rigid_base and rigid.substratum_stack() == () and rigid.base_y == pytest.approx(0.04)
     assert note.endswith(", on a rigid base") and "about 3,041 particles" in note   # 0.4 m x 0.19 m at 5 mm
@@ -161,15 +166,12 @@ def test_the_protocol_runs_the_weak_layer_on_a_rigid_base_and_keys_its_cache_by_
         FieldProtocol(rigid_base=1).validate()
 
 
-def test_a_protocol_with_the_interface_closure_runs_it_and_keeps_the_keys_of_cases_run_without(tmp_path):
+def test_a_protocol_with_the_interface_closure_runs_it_and_keeps_the_keys_of_cases_run_without(cases):
     """The closure is a scene option the protocol passes on; off, the key is the one cases had before the option
     existed (a batch resumes them), on, a key of its own."""
     from mpm_warp.field.batch import case_digest
     from mpm_warp.field.protocol import protocol_params
 
-    table = tmp_path / "psts.csv"
-    table.write_text(TABLE)
-    cases, _ = gather([str(table)], calibrate=False)
     closed = FieldProtocol(interface_closure=True)
     p, _, note = protocol_params(cases[0].params, closed)
     assert p.interface_closure and p.rigid_base and note.endswith(", on a rigid base, laminate closure")
@@ -181,13 +183,10 @@ def test_a_protocol_with_the_interface_closure_runs_it_and_keeps_the_keys_of_cas
         FieldProtocol(interface_closure=1).validate()
 
 
-def test_a_protocol_with_a_pre_cut_starts_each_column_sawn_a_share_of_weacs_critical_cut(tmp_path):
+def test_a_protocol_with_a_pre_cut_starts_each_column_sawn_a_share_of_weacs_critical_cut(cases):
     from mpm_warp.field.batch import _case_id
     from mpm_warp.field.protocol import protocol_params
 
-    table = tmp_path / "psts.csv"
-    table.write_text(TABLE)
-    cases, _ = gather([str(table)], calibrate=False)
     half = FieldProtocol(pre_cut_share=0.5)
     p, tc, note = protocol_params(cases[0].params, half, static_cut=0.2)
     assert p.saw.pre_cut == pytest.approx(0.1) and note.endswith(", pre-cut 10.0 cm")
@@ -200,16 +199,13 @@ def test_a_protocol_with_a_pre_cut_starts_each_column_sawn_a_share_of_weacs_crit
         FieldProtocol(pre_cut_share=1.0).validate()
 
 
-def test_the_pre_cut_is_measured_on_weacs_critical_cut_of_the_column(tmp_path):
+def test_the_pre_cut_is_measured_on_weacs_critical_cut_of_the_column(cases):
     """The cut at which weac's energy release rate of the column reaches the case's fracture energy."""
-    from mpm_warp.field.batch import _static_cut
+    from mpm_warp.field.static_view import static_view
     from mpm_warp.scenes.pst.static import static_column
     from mpm_warp.scenes.weac_reference import energy_release_rate
 
-    table = tmp_path / "psts.csv"
-    table.write_text(TABLE)
-    cases, _ = gather([str(table)], calibrate=False)
-    a = _static_cut(cases[0])
+    a = static_view(cases[0].params).critical_cut
     assert 0.0 < a < 0.4
     assert energy_release_rate(static_column(cases[0].params), a)[0] == pytest.approx(0.3, rel=0.02)   # w_f given
 

@@ -23,6 +23,7 @@ from mpm_warp.field.forecast_intervals import forecast_intervals
 from mpm_warp.field.information_bar import grouped_folds, information_bar
 from mpm_warp.field.probability import outcome_probability, weibull_break_probability
 from mpm_warp.field.scoring import score_records
+from mpm_warp.scenes.pst.outcome import FIELD_CLASSES
 
 OBS = ["END", "END", "SF", "ARR"]
 PROB = np.array([[0.6, 0.3, 0.1],
@@ -108,7 +109,7 @@ def test_weibull_reading_of_one_run():
 
 def _set(n_pits=12, per_pit=2, seed=0):
     rng = np.random.default_rng(seed)
-    classes = ("END", "SF", "ARR")
+    classes = FIELD_CLASSES
     obs, pits, X = [], [], []
     for k in range(n_pits):
         for j in range(per_pit):

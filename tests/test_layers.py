@@ -23,29 +23,17 @@ LAYERS = ["kernels", "engine", "validation", "scenes", "scene API", "post", "fie
           "facade"]
 
 
+#: the layer of each top-level package or module named after its layer or not (the rest is the engine)
+TOP_LAYER = {"kernels": "kernels", "validation": "validation", "scenes": "scenes", "loader": "scene API",
+             "runner": "scene API", "post": "post", "field": "field", "studies": "studies",
+             **dict.fromkeys(("cli", "cli_field", "docgen", "sweep", "sweep_summary"), "CLI and sweeps")}
+
+
 def layer(module: str) -> int:
     """Index in :data:`LAYERS` of a module of the package."""
-    parts = module.split(".")
     if module == "mpm_warp":
         return LAYERS.index("facade")
-    top = parts[1]
-    if top == "kernels":
-        return LAYERS.index("kernels")
-    if top == "validation":
-        return LAYERS.index("validation")
-    if top == "scenes":
-        return LAYERS.index("scenes")
-    if top in ("loader", "runner"):
-        return LAYERS.index("scene API")
-    if top == "post":
-        return LAYERS.index("post")
-    if top == "field":
-        return LAYERS.index("field")
-    if top == "studies":
-        return LAYERS.index("studies")
-    if top in ("cli", "cli_field", "docgen", "sweep", "sweep_summary"):
-        return LAYERS.index("CLI and sweeps")
-    return LAYERS.index("engine")
+    return LAYERS.index(TOP_LAYER.get(module.split(".")[1], "engine"))
 
 
 def modules() -> dict[str, str]:

@@ -18,7 +18,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from helpers_validation import DEVICE, block_on_floor, slope_gravity
+from helpers_validation import DEVICE, apic_momenta, block_on_floor, slope_gravity
 
 import mpm_warp as mw
 from mpm_warp.errors import SimulationBlowUp
@@ -169,17 +169,6 @@ def _free_2d(velocity, dt=2e-4, E=2e4, precision="float64", gravity=(0.0, 0.0)):
         blocks=(mw.Block("m", (0.3, 0.3), (0.7, 0.6), velocity=velocity),), precision=precision)
 
 
-def _momenta_2d(sim):
-    m = sim.model.groups[0].mass
-    x = sim.state.x.numpy().astype(np.float64)
-    v = sim.state.v.numpy().astype(np.float64)
-    C = sim.state.C.numpy().astype(np.float64)
-    D = sim.model.dx ** 2 / 4.0
-    P = m * v.sum(axis=0)
-    L = m * (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]).sum() + m * D * (C[:, 1, 0] - C[:, 0, 1]).sum()
-    return P, L
-
-
 def test_momentum_conserved_2d():
     """Linear and angular momentum (with the APIC spin term) conserved to round-off in 2D, float64."""
     def vel(x):
@@ -187,10 +176,10 @@ def test_momentum_conserved_2d():
                          -0.1 + 1.5 * (x[:, 0] - 0.5) + 0.05 * np.sin(11 * x[:, 0])], axis=1)
 
     sim = mw.Simulation(_free_2d(vel), device=DEVICE)
-    P0, L0 = _momenta_2d(sim)
+    P0, L0 = apic_momenta(sim)
     sim.stepper.set_frame_end(1.0)
     sim.stepper.steps(200)
-    P1, L1 = _momenta_2d(sim)
+    P1, L1 = apic_momenta(sim)
     assert sim.energies()["elastic_energy"] > 0.0
     np.testing.assert_allclose(P1, P0, rtol=0, atol=1e-12 * np.abs(P0).max())
     assert abs(L1 - L0) <= 1e-10 * abs(L0)

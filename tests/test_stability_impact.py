@@ -79,6 +79,21 @@ def test_impact_faster_than_dx_over_dt_wall_holds():
     assert sim.stepper.edge_count() == (0, 0)
 
 
+def _first_step_of_frame_bounds_speed(sim, what: str) -> None:
+    """One step of a frame ending at 1 ms: its dt is the CFL step with the block's speed (0.4 dx / (c_p + |v|),
+    5 % slack) and no particle crosses more than a cell."""
+    st = sim.stepper
+    st.set_frame_end(0.001)
+    x0 = sim.state.x.numpy().astype(np.float64)
+    st.steps(1)
+    _, dt, _ = st.clock()
+    moved = np.linalg.norm(sim.state.x.numpy().astype(np.float64) - x0, axis=1).max() / sim.model.dx
+    expected_dt = 0.4 * sim.model.dx / (IMPACT_MAT.p_wave_speed + IMPACT_V0)
+    print(f"{what}: dt {dt:.3e} s (CFL with |v| {expected_dt:.3e} s), moved {moved:.2f} dx")
+    assert moved <= 1.0
+    assert dt <= 1.05 * expected_dt
+
+
 def test_impact_first_step_accounts_for_initial_speed():
     """The very first automatic step must use the initial particle speeds: no cell skipped at step 1.
 
@@ -87,17 +102,7 @@ def test_impact_first_step_accounts_for_initial_speed():
     dt = 0.4 dx / c_p and the block moves 1.72 cells in it (the health check,
     run every 20 steps with the then-adapted dt, does not see it).
     """
-    sim = mw.Simulation(_impact_scene(end=0.001), device=DEVICE)
-    st = sim.stepper
-    st.set_frame_end(0.001)
-    x0 = sim.state.x.numpy().astype(np.float64)
-    st.steps(1)
-    _, dt, _ = st.clock()
-    moved = np.linalg.norm(sim.state.x.numpy().astype(np.float64) - x0, axis=1).max() / sim.model.dx
-    expected_dt = 0.4 * sim.model.dx / (IMPACT_MAT.p_wave_speed + IMPACT_V0)
-    print(f"first step: dt {dt:.3e} s (CFL with |v| {expected_dt:.3e} s), moved {moved:.2f} dx")
-    assert moved <= 1.0
-    assert dt <= 1.05 * expected_dt
+    _first_step_of_frame_bounds_speed(mw.Simulation(_impact_scene(end=0.001), device=DEVICE), "first step")
 
 
 def test_step_past_frame_end_keeps_speed_bound():
@@ -116,15 +121,7 @@ def test_step_past_frame_end_keeps_speed_bound():
     t_frame, _, steps = st.clock()
     st.steps(2)                               # what the tail of an overshooting batch does
     assert st.clock()[0] == t_frame and st.clock()[2] == steps
-    st.set_frame_end(0.001)
-    x1 = sim.state.x.numpy().astype(np.float64)
-    st.steps(1)
-    _, dt, _ = st.clock()
-    moved = np.linalg.norm(sim.state.x.numpy().astype(np.float64) - x1, axis=1).max() / sim.model.dx
-    expected_dt = 0.4 * sim.model.dx / (IMPACT_MAT.p_wave_speed + IMPACT_V0)
-    print(f"first step after a no-op: dt {dt:.3e} s (CFL with |v| {expected_dt:.3e} s), moved {moved:.2f} dx")
-    assert moved <= 1.0
-    assert dt <= 1.05 * expected_dt
+    _first_step_of_frame_bounds_speed(sim, "first step after a no-op")
 
 
 def test_impact_with_fixed_step_is_a_clear_error():

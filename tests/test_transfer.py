@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import warp as wp
 from helpers_device import DEVICE  # MPM_WARP_TEST_DEVICE
+from helpers_validation import apic_momenta
 
 import mpm_warp
 from mpm_warp.kernels.shape import stencil_func
@@ -88,18 +89,6 @@ def test_affine_field_survives_p2g_g2p(precision):
     np.testing.assert_allclose(C, np.broadcast_to(A, C.shape), atol=20 * tol)
 
 
-def _momenta(sim):
-    m = sim.model.groups[0].mass
-    x = sim.state.x.numpy().astype(np.float64)
-    v = sim.state.v.numpy().astype(np.float64)
-    C = sim.state.C.numpy().astype(np.float64)
-    D = sim.model.dx ** 2 / 4.0
-    P = m * v.sum(axis=0)
-    spin = np.stack([C[:, 2, 1] - C[:, 1, 2], C[:, 0, 2] - C[:, 2, 0], C[:, 1, 0] - C[:, 0, 1]], axis=1)
-    L = m * np.cross(x, v).sum(axis=0) + m * D * spin.sum(axis=0)
-    return P, L
-
-
 def test_momentum_conserved_without_walls_or_gravity():
     """Linear and angular momentum (with the APIC spin term) conserved to round-off, float64."""
     def vel(x):
@@ -108,10 +97,10 @@ def test_momentum_conserved_without_walls_or_gravity():
 
     sc = _free_scene("float64", velocity=vel, dt=2e-4, E=2e4)
     sim = mpm_warp.Simulation(sc, device=DEVICE)
-    P0, L0 = _momenta(sim)
+    P0, L0 = apic_momenta(sim)
     sim.stepper.set_frame_end(1.0)
     sim.stepper.steps(200)
-    P1, L1 = _momenta(sim)
+    P1, L1 = apic_momenta(sim)
     assert sim.energies()["elastic_energy"] > 0.0  # the block is really deforming
     np.testing.assert_allclose(P1, P0, rtol=0, atol=1e-12 * np.abs(P0).max() + 1e-14)
     np.testing.assert_allclose(L1, L0, rtol=0, atol=1e-10 * np.abs(L0).max())

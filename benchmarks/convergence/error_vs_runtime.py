@@ -49,6 +49,7 @@ from mpm_warp.errors import SimulationBlowUp
 from mpm_warp.finite_json import dump_finite, load_json
 from mpm_warp.studies.convergence import observed_order, time_to_target
 from mpm_warp.studies.environment import check_provenance, environment
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import PROBLEMS
 
@@ -145,10 +146,7 @@ def pst_estimate() -> dict:
 
 def plot(data: dict, path: str) -> None:
     """Log-log error against wall time: one colour per problem; solid dx ladder, dashed CFL ladder."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, ax = plt.subplots(figsize=(8.5, 6))
     colors = dict(zip(data["problems"], plt.cm.tab10.colors, strict=False))
@@ -179,8 +177,7 @@ def plot(data: dict, path: str) -> None:
                  "labels: cells)", fontsize=10)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7, loc="lower left")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    save_figure(fig, path)
 
 
 def markdown(data: dict) -> str:

@@ -68,6 +68,7 @@ from mpm_warp.memory import estimate_memory
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.studies.convergence import errors_against_reference, ladder_summary
 from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import (
     PST_BRACKET,
@@ -229,10 +230,9 @@ def summarise(ladder: str, levels: list[dict]) -> dict:
 
 
 def figure(data: dict, path: str) -> None:
-    import matplotlib
+    import matplotlib.ticker
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.6))
     for ax, ladder in zip(axes, ("pst", "shear"), strict=True):
@@ -273,9 +273,7 @@ def figure(data: dict, path: str) -> None:
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         if drawn:
             ax.legend(fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def load(results: str, name: str = OUT) -> dict:

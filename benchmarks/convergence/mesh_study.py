@@ -56,6 +56,7 @@ from mpm_warp.finite_json import dump_finite, load_json
 from mpm_warp.materials import hardening_collapse
 from mpm_warp.studies.convergence import observed_order
 from mpm_warp.studies.environment import check_provenance, environment
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.validation import G, oedometric_collapse, run_column, weak_layer_column
 
@@ -113,10 +114,7 @@ def summarise(runs: list[dict]) -> list[dict]:
 
 def plot(data: dict, path: str) -> None:
     """Collapse against the load with the closed form; error against cells across the layer."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     runs = [r for r in data["runs"] if r["precision"] == data["precision"]]
     xis = sorted({r["xi"] for r in runs})
@@ -181,8 +179,7 @@ def plot(data: dict, path: str) -> None:
     ax2.legend(fontsize=7)
     ax2.grid(alpha=0.3)
     fig.suptitle("Weak-layer collapse under a slab (SI Note 3): mesh, xi and p0 (slab density)", fontsize=11)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    save_figure(fig, path)
 
 
 def main(argv=None) -> int:

@@ -29,6 +29,7 @@ import warnings
 from mpm_warp.field.batch import case_digest, gather, run_cases
 from mpm_warp.field.cases import FieldCase
 from mpm_warp.field.protocol import FieldProtocol
+from mpm_warp.scenes.pst.outcome import FIELD_CLASSES
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -91,7 +92,7 @@ def draw(batches: list[str], per_class: int, seed: int, max_wall: float) -> tupl
     ordered = sorted(pool.values(), key=lambda c: c["id"])
     rng = random.Random(seed)
     chosen = []
-    for cls in ("END", "SF", "ARR"):
+    for cls in FIELD_CLASSES:
         of = [c for c in ordered if c["observed"] == cls]
         chosen += rng.sample(of, min(per_class, len(of)))
     return chosen, len(ordered)

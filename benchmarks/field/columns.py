@@ -31,8 +31,8 @@ from mpm_warp.studies.protocol import out_dir, parser, result_name
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 #: the made-up columns of --quick (two grids; the crack runs away in none)
-QUICK_TABLE = """id,outcome,slope_deg,column_cm,cut_cm,slab_cm,slab_density,weak_layer_cm,weak_layer_density,w_f,column_ends
-tiny-a,End,0,40,12,15,180,4,,0.3,
+QUICK_TABLE = ("id,outcome,slope_deg,column_cm,cut_cm,slab_cm,slab_density,weak_layer_cm,weak_layer_density,w_f,"
+               "column_ends\n") + """tiny-a,End,0,40,12,15,180,4,,0.3,
 tiny-b,Arr,0,40,15,15,180,4,,0.5,vertical
 tiny-c,End,0,40,12,15,180,5,,0.3,
 """

@@ -23,6 +23,7 @@ import warnings
 
 from mpm_warp.field.batch import gather, run_records
 from mpm_warp.field.run_on import scenario_of
+from mpm_warp.scenes.pst.outcome import FIELD_CLASSES
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -147,7 +148,7 @@ def main(argv=None) -> int:
     cases, _ = gather([os.path.join(args.data, p) for p in sorted({r["pit"] for r in recs})], calibrate=False)
     by = {(c.pit, c.test): c for c in cases}
     rows = [describe(r, by[(r["pit"], r["test"])], r["run_dir"]) for r in recs if (r["pit"], r["test"]) in by]
-    classes = ("END", "SF", "ARR")
+    classes = FIELD_CLASSES
     data = {"name": "field_disagreements", "runs": [os.path.basename(os.path.normpath(d)) for d in args.runs],
             "data": os.path.basename(os.path.normpath(args.data)), "environment": environment("cpu"),
             "by_observed": {c: group([r for r in rows if r["observed"] == c]) for c in classes},

@@ -30,6 +30,7 @@ from mpm_warp.field.protocol import FieldProtocol, run_until_decided
 from mpm_warp.io.checkpoint import read_checkpoint_meta
 from mpm_warp.loader import resolved_scenario
 from mpm_warp.scenes.pst import build
+from mpm_warp.scenes.pst.outcome import FIELD_CLASSES
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -74,7 +75,7 @@ def main(argv=None) -> int:
                    and r["wall_s"] <= cap), key=lambda rd: rd[0]["id"])
     rng = random.Random(a.seed)
     chosen = []
-    for cls in ("END", "SF", "ARR"):
+    for cls in FIELD_CLASSES:
         of = [rd for rd in pool if rd[0]["observed"] == cls]
         chosen += rng.sample(of, min(a.per_class, len(of)))
     chosen = chosen[:1] if a.quick else chosen

@@ -33,6 +33,7 @@ from taichi_peer import run_taichi_block_subprocess
 from mpm_warp.finite_json import load_json
 from mpm_warp.studies import plastic_block as pb
 from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
@@ -112,10 +113,9 @@ def run(dims, materials, particles, steps: int, device: str, threads_list, taich
 
 def figure(out: dict, path: str) -> None:
     """Particle-steps per second against particles: one panel per dimension, a line per material and engine."""
-    import matplotlib
+    import matplotlib.ticker
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     rows = [r for r in out["rows"] if "particle_steps_per_s" in r]
     dims = sorted({r["dim"] for r in rows}, reverse=True)
@@ -137,9 +137,7 @@ def figure(out: dict, path: str) -> None:
                title=f"{dim}D{' (plane strain)' if dim == 2 else ''}, {out['environment']['device']}")
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.15))  # below: no point hidden
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv=None) -> int:

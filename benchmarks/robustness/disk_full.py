@@ -90,14 +90,19 @@ def tmpfs_sweep(sizes_kib, ref) -> list[dict]:
 
             def resume(d=d):
                 subprocess.run(["mount", "-o", "remount,size=64m", d], check=True)
-                return subprocess.run(CLI + ["resume", os.path.join(d, "r.h5"), "--quiet", "--device", "cpu"],
-                                      capture_output=True, text=True, timeout=300)
+                return _resume(d)
 
             out.append(_case("tmpfs", kib, p, d, ref, resume))
         finally:
             subprocess.run(["umount", d])
             os.rmdir(d)
     return out
+
+
+def _resume(d: str) -> subprocess.CompletedProcess:
+    """``mpm-warp resume`` of the run ``r.h5`` in the folder ``d`` on the CPU, its output captured."""
+    return subprocess.run(CLI + ["resume", os.path.join(d, "r.h5"), "--quiet", "--device", "cpu"],
+                          capture_output=True, text=True, timeout=300)
 
 
 def fsize_sweep(sizes_kib, ref) -> list[dict]:
@@ -107,9 +112,7 @@ def fsize_sweep(sizes_kib, ref) -> list[dict]:
         try:
             p = subprocess.run([sys.executable, "-c", LIMITED, str(kib * 1024), *_run_args(os.path.join(d, "r.h5"))],
                                capture_output=True, text=True, timeout=300)
-            out.append(_case("fsize", kib, p, d, ref, lambda d=d: subprocess.run(
-                CLI + ["resume", os.path.join(d, "r.h5"), "--quiet", "--device", "cpu"], capture_output=True,
-                text=True, timeout=300)))
+            out.append(_case("fsize", kib, p, d, ref, lambda d=d: _resume(d)))
         finally:
             shutil.rmtree(d)
     return out
@@ -128,9 +131,7 @@ def strace_sweep(indices, ref) -> list[dict]:
             if p.returncode == 0:                      # fewer pwrites than k: the run never met the fault
                 out.append(dict(kind="strace", size=k, rc=0, note="finished before the K-th pwrite"))
                 break
-            out.append(_case("strace", k, p, d, ref, lambda d=d: subprocess.run(
-                CLI + ["resume", os.path.join(d, "r.h5"), "--quiet", "--device", "cpu"], capture_output=True,
-                text=True, timeout=300)))
+            out.append(_case("strace", k, p, d, ref, lambda d=d: _resume(d)))
         finally:
             shutil.rmtree(d)
     return out

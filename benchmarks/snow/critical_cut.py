@@ -39,7 +39,8 @@ from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.pst.static import weac_answer
 from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.figures import pyplot, save_figure
+from mpm_warp.studies.protocol import out_dir, parse_cases, parser
 from mpm_warp.studies.snow import FIELD_CUT, ladder_pst
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -66,10 +67,7 @@ OUT = "snow_critical_cut"
 
 
 def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     return plt
 
@@ -152,9 +150,7 @@ def figure(data: dict, path: str) -> None:
     ax.legend(handles=key, loc="upper center", bbox_to_anchor=(0.5, -0.12 - 0.3 / len(cases)), ncol=3,
               fontsize=8, frameon=False, title=f"grey: the field's {FIELD_CUT[0]:g}-{FIELD_CUT[1]:g} m",
               title_fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def reference(name: str, data: dict) -> float | None:
@@ -191,11 +187,7 @@ def run_case(name: str, data: dict, device: str) -> dict:
 
 def main(argv=None) -> int:
     ap = parser(__doc__, "the ladder PST at 6 cells on a 1.2 m column, bisected once: a base run and two trials")
-    ap.add_argument("cases", nargs="*", help=f"any of {', '.join(CASES)} (none: redraw the figure)")
-    a = ap.parse_args(argv)
-    bad = [c for c in a.cases if c not in CASES]
-    if bad:
-        ap.error(f"unknown case(s) {', '.join(bad)}: choose from {', '.join(CASES)}")
+    a = parse_cases(ap, argv, CASES, "none: redraw the figure")
     if a.quick:
         a.cases = ["quick"]
     folder = (a.out or RESULTS) if not a.cases else out_dir(a, RESULTS, "critical_cut")

@@ -32,6 +32,7 @@ from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.shear_test import shear_curves
 from mpm_warp.studies import interface_model1d
 from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.interface_column import column_rows, free_column_rows, running_rows, step_cost
 from mpm_warp.studies.protocol import out_dir, parser, result_name
 from mpm_warp.studies.snow import PST_BRACKET, PST_DX, ladder_pst
@@ -143,10 +144,7 @@ def shear_part(cells, device: str) -> dict:
 
 
 def figure(data: dict, path: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     col = data["column"]
     fig, ax = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
@@ -166,9 +164,7 @@ def figure(data: dict, path: str) -> None:
     ax[0].set_ylabel("height above the weak layer's base / its thickness [-]")
     fig.suptitle("settled column (pst_demo's stack between slip walls): rows within 3 cells of the weak layer; "
                  "grey band: 5 %", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv=None) -> int:

@@ -38,6 +38,7 @@ from mpm_warp.finite_json import load_json
 from mpm_warp.studies.convergence import loglog_slope
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.fanout import dask_map
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import DEM_STEADY_MAX, STEADY_FROM, ladder_pst
 
@@ -119,10 +120,9 @@ def trends(rows: list[dict], h_fit: float) -> dict:
 
 
 def figure(data: dict, path: str) -> None:
-    import matplotlib
+    import matplotlib.ticker
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
     rows = {(r["param"], r["value"]): r for k in ("slab.E", "weak_layer.h_c") for r in data["trends"][k]["cases"]}
@@ -169,9 +169,7 @@ def figure(data: dict, path: str) -> None:
     axes[1].set_title("against slab stiffness (h_c: WEAC fit)", fontsize=9)
     axes[2].set_title("against collapse height (h_c x 0.5, 1, 2; E 5 MPa)", fontsize=9)
     fig.suptitle("PST on an 8 m column (0.3 m slab, 6 cm layer, dx 10 mm): one parameter at a time", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv=None) -> int:

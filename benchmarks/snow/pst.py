@@ -40,6 +40,7 @@ from mpm_warp.scenes.pst.analysis import rederive_speeds
 from mpm_warp.scenes.pst.saw import sawn
 from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, git_commit, write_json
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import FIELD_SPEED, ladder_pst
 
@@ -51,10 +52,7 @@ TOUCHDOWN_NULL = "null before the deflection front ran 4 bins beyond the cut (no
 
 
 def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     return plt
 
@@ -151,9 +149,7 @@ def figure(res: dict, profiles: list[dict], path: str) -> None:
     ax[2].invert_yaxis()
     ax[2].legend(fontsize=7)
     fig.suptitle(res["description"], fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv=None) -> int:

@@ -41,7 +41,7 @@ from mpm_warp.scenes.pst.static import static_column
 from mpm_warp.scenes.snowpack import SnowLayer
 from mpm_warp.scenes.weac_reference import energy_release_rate, slab_stress, weac_unavailable
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.protocol import out_dir, parse_cases, parser
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
@@ -136,11 +136,7 @@ def run_case(name: str, folder: str, device: str) -> dict:
 
 def main(argv=None) -> int:
     ap = parser(__doc__, "a 0.8 m column with a 12 cm soft slab: SF")
-    ap.add_argument("cases", nargs="*", help=f"any of {', '.join(CASES)} (default: all)")
-    a = ap.parse_args(argv)
-    bad = [c for c in a.cases if c not in CASES]
-    if bad:
-        ap.error(f"unknown case(s) {', '.join(bad)}: choose from {', '.join(CASES)}")
+    a = parse_cases(ap, argv, CASES)
     names = ["quick"] if a.quick else (a.cases or list(CASES))
     folder = out_dir(a, RESULTS, "pst_outcomes")
     data = {"cases": {}}

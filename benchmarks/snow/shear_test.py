@@ -22,6 +22,7 @@ import numpy as np
 import mpm_warp as mw
 from mpm_warp.scenes.shear_test import shear_curves
 from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
@@ -42,10 +43,7 @@ def run(cells: int, device: str) -> dict:
 
 
 def figure(runs: list, path: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     r0 = runs[0]["result"]
@@ -69,9 +67,7 @@ def figure(runs: list, path: str) -> None:
         a.legend(fontsize=7)
     fig.suptitle("unconfined shear test (SI Note 2): the weak layer under the slab's load, pushed at 0.01 m/s",
                  fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv=None) -> int:

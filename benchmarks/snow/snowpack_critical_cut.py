@@ -35,7 +35,8 @@ from mpm_warp.finite_json import load_json
 from mpm_warp.scenes.pst import critical_cut
 from mpm_warp.scenes.snowpack import SnowLayer
 from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.figures import pyplot, save_figure
+from mpm_warp.studies.protocol import out_dir, parse_cases, parser
 from mpm_warp.studies.snow import ladder_pst
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -101,10 +102,7 @@ def derived(cases: dict) -> dict:
 
 
 def figure(data: dict, path: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     cases = data["cases"]
     fig, ax = plt.subplots(figsize=(9, 1.9 + 0.5 * len(cases)))
@@ -121,9 +119,7 @@ def figure(data: dict, path: str) -> None:
                ax.plot([], [], "*", color="C2", ms=11, mfc="none")[0]]
     ax.legend(handles, ["arrested", "propagated", "bracket", "weac (energy criterion, G = w_f)"], loc="upper center",
               bbox_to_anchor=(0.5, -0.16), ncols=4, fontsize=8, frameon=False)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def load(folder: str) -> dict:
@@ -136,12 +132,8 @@ def load(folder: str) -> dict:
 
 def main(argv=None) -> int:
     ap = parser(__doc__, "the layered ladder PST on a 1.2 m column, bisected once")
-    ap.add_argument("cases", nargs="*", help=f"any of {', '.join(CASES)} (default: all)")
     ap.add_argument("--figure", action="store_true", help="only redraw the figure from the JSON")
-    a = ap.parse_args(argv)
-    bad = [c for c in a.cases if c not in CASES]
-    if bad:
-        ap.error(f"unknown case(s) {', '.join(bad)}: choose from {', '.join(CASES)}")
+    a = parse_cases(ap, argv, CASES)
     folder = out_dir(a, RESULTS, OUT) if not a.figure else (a.out or RESULTS)
     if a.figure:
         figure(load(folder), os.path.join(folder, OUT + ".png"))

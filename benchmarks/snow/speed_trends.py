@@ -39,6 +39,7 @@ from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.convergence import loglog_slope
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.fanout import dask_map
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import FIELD_SPEED, ladder_pst
 
@@ -67,10 +68,9 @@ def one_case(param: str, value: float, device: str, column: list = COLUMN, cut: 
 
 
 def figure(data: dict, path: str) -> None:
-    import matplotlib
+    import matplotlib.ticker
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     cut = data.get("cut", CUT)
@@ -108,9 +108,7 @@ def figure(data: dict, path: str) -> None:
     axes[1].set_title("speed against collapse height (h_c x 0.5, 1, 2 of the WEAC fit; E = 5 MPa)", fontsize=9)
     fig.suptitle("PST (2.2 m column, 0.3 m slab, 6 cm layer at 6 cells, cut 0.7 m): one parameter at a time",
                  fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv=None) -> int:

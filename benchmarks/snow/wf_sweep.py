@@ -26,6 +26,7 @@ import time
 from mpm_warp.scenes.weak_layer import stored_calibration
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.fanout import dask_map
+from mpm_warp.studies.figures import pyplot, save_figure
 from mpm_warp.studies.protocol import out_dir, parser
 from mpm_warp.studies.snow import FIELD_CUT, FIELD_SPEED, ladder_pst
 
@@ -58,10 +59,7 @@ def one_case(w_f: float, lo: float, hi: float, tol: float, device: str, column: 
 
 
 def figure(rows: list, path: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     w = [r["w_f"] for r in rows]
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -86,9 +84,7 @@ def figure(rows: list, path: str) -> None:
     ax[1].legend(fontsize=8)
     fig.suptitle("PST (2.2 m column, 0.3 m slab, 6 cm layer at 6 cells): the weak layer's fracture energy swept, "
                  "everything else fixed", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv=None) -> int:

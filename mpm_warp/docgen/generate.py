@@ -9,18 +9,13 @@ and is replaced whole; the text around the markers is left as written.
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 
-from ..markers import with_block
+from ..markers import checkout_root, generator_args, with_block, write_generated
 from . import cli_doc, keys_doc
 
 __all__ = ["generated_files", "main"]
-
-
-def _root() -> str:
-    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def _blocks() -> dict[str, list[tuple[str, str, list[str]]]]:
@@ -41,7 +36,7 @@ def generated_files(root: str | None = None) -> dict[str, tuple[str, str]]:
     ValueError
         A file that lacks one of its blocks' markers (the block would silently not be written).
     """
-    root = root or _root()
+    root = root or checkout_root()
     out = {}
     for rel, blocks in _blocks().items():
         with open(os.path.join(root, rel)) as fh:
@@ -58,19 +53,13 @@ def generated_files(root: str | None = None) -> dict[str, tuple[str, str]]:
 
 def main(argv=None) -> int:
     """Write (or with ``--check`` only compare) the generated blocks; the exit status 1 means out of date."""
-    ap = argparse.ArgumentParser(prog="python -m mpm_warp.docgen", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--root", default=None, help="the repository (default: the checkout this package runs from)")
-    ap.add_argument("--check", action="store_true", help="write nothing; exit 1 if a generated block is out of date")
-    a = ap.parse_args(argv)
-    root = a.root or _root()
+    a = generator_args("python -m mpm_warp.docgen", __doc__, "block", argv)
+    root = a.root or checkout_root()
     files = generated_files(root)
     stale = [rel for rel, (old, new) in files.items() if old != new]
     if not a.check:
         for rel in stale:
-            path = os.path.join(root, rel)
-            with open(path + ".tmp", "w") as fh:
-                fh.write(files[rel][1])
-            os.replace(path + ".tmp", path)
+            write_generated(os.path.join(root, rel), files[rel][1])
     for rel in stale:
         print(("out of date: " if a.check else "wrote ") + rel)
     if not stale:

@@ -42,7 +42,7 @@ from .plain_words import in_field_terms
 from .protocol import FieldProtocol, protocol_params
 from .scores import field_class
 from .scoring import score_records
-from .static_rule import weac_static_rule
+from .static_view import static_view
 
 __all__ = ["run_field", "run_cases", "gather", "score_records", "finished_records", "run_records", "case_digest",
            "case_scenario", "FieldBatch"]
@@ -122,25 +122,14 @@ def run_records(run_dirs) -> list[tuple[dict, str]]:
     return out
 
 
-def _static_cut(case: FieldCase) -> float | None:
-    """weac's critical cut (m) of the case's column at its fracture energy; None when it is not critical or weac
-    is not installed."""
-    from ..scenes.pst.static import static_column
-    from ..scenes.weac_reference import critical_cut, weac_unavailable
-
-    if weac_unavailable() is not None:
-        return None
-    p = case.params
-    return critical_cut(static_column(p), p.weak_layer.w_f)
-
-
 def case_scenario(case: FieldCase, proto: FieldProtocol):
     """The scenario a batch runs for ``case`` under ``proto`` and its setup note: ``(scenario, note)``, or
     ``(None, reason)`` where the column exceeds the per-case budget. Building it calibrates the weak layer; an
     InvalidArgument says what the model cannot represent."""
     from ..scenes.pst import build
 
-    params, tc, note = protocol_params(case.params, proto, _static_cut(case) if proto.pre_cut_share > 0.0 else None)
+    params, tc, note = protocol_params(case.params, proto,
+                                       static_view(case.params).critical_cut if proto.pre_cut_share > 0.0 else None)
     return (None, note) if params is None else (build(params, tc, name="field"), note)
 
 
@@ -157,10 +146,10 @@ def _task(c: FieldCase, k: int, out_dir, proto, device, refused) -> dict | None:
         return None
     wf = c.fracture_energy
     source = "given" if wf.reason == "given" else ("read back" if wf.value is not None else wf.reason)
-    static = weac_static_rule(c.params)
+    static = static_view(c.params)
     return {"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
-            "recorded_cut": c.record.cut_length, **case_record_features(c), "static_class": static["class"],
-            "static_peak_ratio": static["peak_ratio"], "w_f": params.weak_layer.w_f, "w_f_source": source,
+            "recorded_cut": c.record.cut_length, **case_record_features(c), "static_class": static.static_class,
+            "static_peak_ratio": static.peak_ratio, "w_f": params.weak_layer.w_f, "w_f_source": source,
             "setup": note, "scenario": scenario, "out_dir": out_dir, "device": device, "threads": proto.threads}
 
 

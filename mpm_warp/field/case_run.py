@@ -16,7 +16,7 @@ import traceback
 from .. import io
 from .information_bar import CASE_FEATURES
 from .probability import outcome_probability
-from .protocol import decided
+from .protocol import decided, run_to_decision
 
 __all__ = ["run_case", "run_case_group", "write_case_record", "column_step"]
 
@@ -72,21 +72,13 @@ def _failed(rec: dict, e: BaseException) -> None:
 
 def run_case(task: dict) -> dict:
     """One case in a worker (never raises: a failure is a record with its error)."""
-    from ..runner import run
-
     t0 = time.perf_counter()
     out = os.path.join(task["out_dir"], task["id"])
     rec = _new_record(task)
-    used = {}
-
-    def until_decided(sim, frame):
-        used["threads"] = sim.stepper.n_threads        # the threads the step really ran on
-        return not decided(sim)
-
     try:
-        res = run(task["scenario"], out + ".part.h5", device=task["device"], overwrite=True,
-                  n_threads=task.get("threads"), callback=until_decided)
-        _finish(rec, task, res, used.get("threads"))
+        res, threads = run_to_decision(task["scenario"], out + ".part.h5", device=task["device"],
+                                       n_threads=task.get("threads"))
+        _finish(rec, task, res, threads)
     except Exception as e:      # a failing case is recorded with its error; it never stops the batch
         _failed(rec, e)
     rec["case_wall_s"] = time.perf_counter() - t0

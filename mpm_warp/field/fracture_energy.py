@@ -51,10 +51,11 @@ class ImpliedFractureEnergy:
 def implied_fracture_energy(params, cut: float) -> ImpliedFractureEnergy:
     """The fracture energy a PST column ``params`` (PSTParams, the field column) implies at its recorded ``cut`` (m).
 
-    weac (optional) computes G; without it, ``value`` is None and the reason says how to install it.
+    weac (optional) computes G, the solve the case's :func:`~.static_view.static_view` reads at the recorded cut;
+    without it, ``value`` is None and the reason says how to install it.
     """
-    from ..scenes.pst.static import static_column
-    from ..scenes.weac_reference import energy_release_rate, weac_unavailable
+    from ..scenes.weac_reference import weac_unavailable
+    from .static_view import energy_release_at
 
     frac = cut / params.length
     if frac > MAX_CUT_FRACTION:
@@ -63,7 +64,7 @@ def implied_fracture_energy(params, cut: float) -> ImpliedFractureEnergy:
             f"a measure of the weak layer (cuts up to {MAX_CUT_FRACTION:.0%} of the column are read)"))
     if weac_unavailable() is not None:
         return ImpliedFractureEnergy(None, None, None, None, weac_unavailable())
-    G, G_I, G_II = energy_release_rate(static_column(params), float(cut))
+    G, G_I, G_II = energy_release_at(params, cut)
     lo, hi = PLAUSIBLE
     if not lo <= G <= hi:
         return ImpliedFractureEnergy(None, G, G_I, G_II, (

@@ -26,7 +26,8 @@ from ..config import TimeControl
 from ..errors import InvalidArgument
 from ..scenes.pst import PSTParams
 
-__all__ = ["FieldProtocol", "protocol_params", "decided", "particle_estimate", "run_until_decided"]
+__all__ = ["FieldProtocol", "protocol_params", "decided", "particle_estimate", "run_to_decision",
+           "run_until_decided"]
 
 
 @dataclass(frozen=True)
@@ -152,14 +153,27 @@ def decided(sim) -> bool:
     return sim.monitors["pst"].outcome().get("class") is not None
 
 
-def run_until_decided(scenario, path: str, n_threads: int = 1) -> dict:
-    """Run a field column's ``scenario`` on the CPU into ``path`` (overwritten) until its outcome is decided, as a
-    batch does: the row the field studies compare (``predicted``, ``runaway_cut`` (m), ``slab_fracture_at`` (m),
-    ``particles``, ``steps``, ``wall_s`` (s), ``sim_time`` (s))."""
+def run_to_decision(scenario, path: str, *, device: str | None = "cpu", n_threads: int | None = 1):
+    """Run a field column's ``scenario`` into ``path`` (overwritten) until its outcome is decided (:func:`decided`),
+    as a batch does: ``(result, threads)``, the runner's :class:`~mpm_warp.runner.RunResult` and the CPU threads
+    the step really ran on."""
     from ..runner import run
 
-    res = run(scenario, path, device="cpu", overwrite=True, n_threads=n_threads,
-              callback=lambda sim, frame: not decided(sim))
+    used = {}
+
+    def until_decided(sim, frame):
+        used["threads"] = sim.stepper.n_threads
+        return not decided(sim)
+
+    res = run(scenario, path, device=device, overwrite=True, n_threads=n_threads, callback=until_decided)
+    return res, used.get("threads")
+
+
+def run_until_decided(scenario, path: str, n_threads: int = 1) -> dict:
+    """Run a field column's ``scenario`` on the CPU into ``path`` (overwritten) until its outcome is decided, as a
+    batch does (:func:`run_to_decision`): the row the field studies compare (``predicted``, ``runaway_cut`` (m),
+    ``slab_fracture_at`` (m), ``particles``, ``steps``, ``wall_s`` (s), ``sim_time`` (s))."""
+    res, _ = run_to_decision(scenario, path, device="cpu", n_threads=n_threads)
     o = res.scene_result.get("outcome", {})
     return {"predicted": o.get("class"), "runaway_cut": res.scene_result.get("runaway_cut"),
             "slab_fracture_at": o.get("slab_fracture_at"), "particles": res.n_particles, "steps": res.steps,

@@ -8,23 +8,17 @@ dynamics add.
 
 from __future__ import annotations
 
+from .static_view import static_view
+
 __all__ = ["weac_static_rule", "weac_static_class"]
 
 
 def weac_static_rule(params) -> dict:
     """weac's static rule for the field column ``params`` (PSTParams) at its recorded cut: ``class`` ("SF" or "END")
-    and ``peak_ratio`` (the slab's largest tensile stress over its layer's strength, -); both None without weac."""
-    from ..scenes.density_laws import sigrist_tensile_strength
-    from ..scenes.pst.static import static_column
-    from ..scenes.weac_reference import slab_stress, weac_unavailable
-
-    if weac_unavailable() is not None:
-        return {"class": None, "peak_ratio": None}
-    strengths = [ly.tensile_strength if ly.tensile_strength > 0 else sigrist_tensile_strength(ly.density)
-                 for ly in params.slab_stack()]
-    st = slab_stress(static_column(params), float(params.saw.cut_length), strengths, dx=0.01, dz=0.005)
-    ratio = float(st["peak_ratio"])
-    return {"class": "SF" if ratio >= 1.0 else "END", "peak_ratio": ratio}
+    and ``peak_ratio`` (the slab's largest tensile stress over its layer's strength, -); both None without weac.
+    The case's :class:`~.static_view.StaticView` holds both."""
+    view = static_view(params)
+    return {"class": view.static_class, "peak_ratio": view.peak_ratio}
 
 
 def weac_static_class(params) -> str | None:

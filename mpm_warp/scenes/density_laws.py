@@ -150,6 +150,14 @@ def _densities(density, field: str) -> np.ndarray:
     return rho
 
 
+def _power_law(density, scale: float, reference: float, exponent: float):
+    """``scale (rho / reference)^exponent`` of the checked densities ``density`` (kg/m^3): a float for a number,
+    an array for an array (the laws below)."""
+    rho = _densities(density, "density")
+    value = scale * (rho / reference) ** exponent
+    return float(value) if value.ndim == 0 else value
+
+
 def bergfeld_modulus(density):
     """Young's modulus of snow (Pa) from its density: ``E = 6.5e3 MPa (rho / 916.7)^4.4``.
 
@@ -165,9 +173,7 @@ def bergfeld_modulus(density):
     float or numpy.ndarray
         E (Pa): 14.8 MPa at 230 kg/m^3, 6.5 GPa at 916.7 kg/m^3.
     """
-    rho = _densities(density, "density")
-    E = 6.5e9 * (rho / 916.7) ** 4.4
-    return float(E) if E.ndim == 0 else E
+    return _power_law(density, 6.5e9, 916.7, 4.4)
 
 
 def sigrist_tensile_strength(density):
@@ -185,9 +191,7 @@ def sigrist_tensile_strength(density):
     float or numpy.ndarray
         Tensile strength (Pa): 240 kPa at 917 kg/m^3, 10.1 kPa at 250 kg/m^3.
     """
-    rho = _densities(density, "density")
-    s = 240.0e3 * (rho / RHO_ICE) ** 2.44
-    return float(s) if s.ndim == 0 else s
+    return _power_law(density, 240.0e3, RHO_ICE, 2.44)
 
 
 def fracture_toughness(density):
@@ -208,6 +212,4 @@ def fracture_toughness(density):
     float or numpy.ndarray
         K_Ic (Pa m^1/2): 750 at 200 kg/m^3, 422 at 150, 1172 at 250.
     """
-    rho = _densities(density, "density")
-    k = 750.0 * (rho / 200.0) ** 2
-    return float(k) if k.ndim == 0 else k
+    return _power_law(density, 750.0, 200.0, 2)

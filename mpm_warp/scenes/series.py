@@ -28,6 +28,15 @@ class SeriesMonitor:
         self.times: list[float] = []
         self.series: dict[str, list[float]] = {}
 
+    def scene_params(self, sim, params_type):
+        """``sim``'s scene parameters, which must be a ``params_type`` (a scene's parameter class, its ``kind``
+        the scene's package); a TypeError naming this monitor and the scene's builder otherwise."""
+        p = sim.scenario.scene
+        if not isinstance(p, params_type):
+            raise TypeError(f"{type(self).__name__} needs a scenario built by "
+                            f"mpm_warp.scenes.{params_type.kind}.build")
+        return p
+
     # ------------------------------------------------------------- to override
     def actions(self) -> list:
         """Recorded launches run every step."""

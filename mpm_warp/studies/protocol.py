@@ -12,7 +12,7 @@ import argparse
 import os
 import tempfile
 
-__all__ = ["parser", "out_dir", "result_name"]
+__all__ = ["parser", "parse_cases", "out_dir", "result_name"]
 
 
 def parser(doc: str, quick: str, device: str | None = "cpu") -> argparse.ArgumentParser:
@@ -35,6 +35,17 @@ def parser(doc: str, quick: str, device: str | None = "cpu") -> argparse.Argumen
                     help="folder of the JSON and figure (default: the committed results beside the script; "
                          "with --quick a new temporary folder)")
     return ap
+
+
+def parse_cases(ap: argparse.ArgumentParser, argv, cases, none: str = "default: all") -> argparse.Namespace:
+    """Parse ``argv`` with ``ap`` and a positional ``cases``, any of ``cases`` (``none``: what naming none does);
+    an unknown case is the parser's one-line error (exit status 2) naming it and the choices."""
+    ap.add_argument("cases", nargs="*", help=f"any of {', '.join(cases)} ({none})")
+    a = ap.parse_args(argv)
+    bad = [c for c in a.cases if c not in cases]
+    if bad:
+        ap.error(f"unknown case(s) {', '.join(bad)}: choose from {', '.join(cases)}")
+    return a
 
 
 def out_dir(args: argparse.Namespace, results: str, name: str = "study") -> str:

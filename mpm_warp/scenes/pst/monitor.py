@@ -55,10 +55,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
 
     def __init__(self, sim):
         super().__init__()
-        p = sim.scenario.scene
-        if not isinstance(p, PSTParams):
-            raise TypeError("PSTMonitor needs a scenario built by mpm_warp.scenes.pst.build")
-        self.params = p
+        self.params = p = self.scene_params(sim, PSTParams)
         self.sim = sim
         T = sim.model.T
         left = p.cut_at_origin

@@ -50,10 +50,7 @@ class ShearMonitor(ReferenceField, SeriesMonitor):
 
     def __init__(self, sim):
         super().__init__()
-        p = sim.scenario.scene
-        if not isinstance(p, ShearTestParams):
-            raise TypeError("ShearMonitor needs a scenario built by mpm_warp.scenes.shear_test.build")
-        self.params = p
+        self.params = p = self.scene_params(sim, ShearTestParams)
         self.calibration = stored_calibration(sim.scenario)
         self.sim = sim
         T = sim.model.T

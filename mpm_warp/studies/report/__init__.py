@@ -30,10 +30,10 @@ Then run the command and commit ``docs/results.md`` and ``docs/results/``.
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 
+from ...markers import checkout_root, generator_args, write_generated
 from . import (  # noqa: F401
     convergence,
     field,
@@ -68,7 +68,7 @@ __all__ = ["SECTIONS", "Context", "section", "pending", "default_root", "results
 
 def default_root() -> str:
     """The repository this package runs from (an editable install's checkout)."""
-    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    return checkout_root()
 
 
 def results_pages(root: str | None = None) -> dict[str, str]:
@@ -97,18 +97,8 @@ def readme_text(root: str | None = None) -> str | None:
     return text
 
 
-def _write(path: str, text: str) -> None:
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path + ".tmp", "w") as fh:
-        fh.write(text)
-    os.replace(path + ".tmp", path)
-
-
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m mpm_warp.studies.report", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--root", default=None, help="the repository (default: the checkout this package runs from)")
-    ap.add_argument("--check", action="store_true", help="write nothing; exit 1 if a generated file is out of date")
-    a = ap.parse_args(argv)
+    a = generator_args("python -m mpm_warp.studies.report", __doc__, "file", argv)
     root = a.root or default_root()
     targets = [(os.path.join(root, rel), text) for rel, text in results_pages(root).items()]
     readme = readme_text(root)
@@ -120,7 +110,7 @@ def main(argv=None) -> int:
         if old != text:
             stale.append(path)
             if not a.check:
-                _write(path, text)
+                write_generated(path, text)
     pages = os.path.join(root, PAGE_DIR)
     stray = sorted(os.path.join(pages, f) for f in (os.listdir(pages) if os.path.isdir(pages) else [])
                    if f.endswith(".md") and os.path.join(pages, f) not in dict(targets))

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 from ...errors import InvalidArgument
 from ...finite_json import load_json
 
-__all__ = ["PARTS", "Page", "PAGES", "Section", "Context", "SECTIONS", "section", "pending", "render_section", "slug"]
+__all__ = ["PARTS", "Page", "PAGES", "Section", "Context", "SECTIONS", "section", "cases_command", "pending",
+           "render_section", "slug"]
 
 #: The parts of the results, in order: key -> heading.
 PARTS = {"perf": "Performance", "convergence": "Convergence", "snow": "Snow science", "field": "Field data",
@@ -131,6 +132,12 @@ def section(part: str, title: str, source: str, command, figure: str | None = No
         _place(Section(part, title, source, command, render, figure, question, page), follows)
         return render
     return register
+
+
+def cases_command(script: str) -> Callable[[dict], str]:
+    """A section's command for a script that takes the result's case names: ``python benchmarks/SCRIPT`` and the
+    ``cases`` of its JSON (``script`` relative to ``benchmarks/``)."""
+    return lambda d: f"python benchmarks/{script} " + " ".join(d["cases"])
 
 
 #: sections waiting for the one they follow to be registered: its title -> them

@@ -9,7 +9,7 @@ from ...scenes.front_speed import NUCLEATION
 from ...scenes.pst.analysis import SPEED_LIMIT_DISTANCE, SPEED_WINDOW
 from .. import snow as refs
 from ..snow import DEM_STEADY_MAX, FIELD_CUT, FIELD_SPEED, LADDER_PST, LONG_PST_SPEED, STEADY_FROM
-from .core import section
+from .core import cases_command, section
 from .fmt import DASH, bracket, check_line, count, env_note, finite, fx, secs, spct, table
 
 
@@ -251,7 +251,7 @@ def _ladder_reference(ctx, dx: float):
 
 
 @section("snow", "Critical cut", "snow/results/snow_critical_cut.json",
-         lambda d: "python benchmarks/snow/critical_cut.py " + " ".join(d["cases"]),
+         cases_command("snow/critical_cut.py"),
          figure="snow/results/snow_critical_cut.png",
          question="What is the critical cut length, flat, on a slope, at half saw speed? (Bisection on the saw's "
                   "stop position, trial runs forked from one base run.)")

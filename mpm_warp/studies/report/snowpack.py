@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from .core import section
+from .core import cases_command, section
 from .fmt import DASH, bracket, check_line, env_note, finite, fx, secs, spct, table
 
 #: The criterion of a critical cut against weac's: within 20 % (the one ``snowpack_critical_cut.json``'s
@@ -39,7 +39,7 @@ def _where(o: dict) -> str:
 
 
 @section("snow", "The three field outcomes: END, SF, ARR", "snow/results/pst_outcomes.json",
-         lambda d: "python benchmarks/snow/pst_outcomes.py " + " ".join(d["cases"]),
+         cases_command("snow/pst_outcomes.py"),
          question="Does a PST end as the field writes it (the crack reaches the end, the slab breaks, the crack "
                   "arrests), with the slab's break beside weac's peak tensile stress?")
 def render_outcomes(data: dict, ctx) -> list[str]:
@@ -134,7 +134,7 @@ def _classes(c: dict) -> str:
 
 
 @section("snow", "The snowpack's critical cut: layering and column ends", "snow/results/snowpack_critical_cut.json",
-         lambda d: "python benchmarks/snow/snowpack_critical_cut.py " + " ".join(d["cases"]),
+         cases_command("snow/snowpack_critical_cut.py"),
          figure="snow/results/snowpack_critical_cut.png",
          question="Does the snowpack change the critical cut as weac says (layered slabs, slope-normal against "
                   "vertical ends)?")
