@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One command for a CUDA machine (see benchmarks/perf/device_suite.py): device tests, graph against eager,
-# throughput beside Taichi at ~1M/4M/16M particles, bytes per particle, one production flat PST.
+# throughput beside Taichi at ~1M/4M particles, bytes per particle, one production flat PST, a small field batch.
 # Usage: bash benchmarks/device_suite.sh [--device cuda:0] [--quick] [--out DIR] [--parts ...]
 # Python: $PYTHON, else the repository's .venv, else python3.
 set -euo pipefail

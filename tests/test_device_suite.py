@@ -140,3 +140,13 @@ def test_elastic_block_step_stays_stable_at_device_sizes():
         block_scenario(n_grid, dt=dt, dim=2).validate()   # accepted where the fixed 1e-4 s was refused
     with pytest.raises(Exception, match="time.dt"):
         block_scenario(1000, dim=2).validate()
+
+
+@pytest.mark.slow
+def test_the_field_part_stepped_made_up_columns_together_and_one_alone(quick):
+    """Quick mode: two made-up field columns (two grids) together for 2 ms on the suite's device, the first alone on
+    the CPU; each in a class-less state still (2 ms is inside the settling), the same both ways."""
+    f = quick[0]["parts"]["field"]["result"]
+    assert f["columns"] == 2 and f["group"]["failed"] == [] and f["group"]["cases_per_hour"] > 0
+    assert f["group"]["classes"] == [None, None] and f["same_class"] == 1
+    assert len(f["cpu_alone"]["cases"]) == 1 and f["speedup"] > 0

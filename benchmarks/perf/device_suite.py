@@ -33,12 +33,15 @@ the CPU in seconds, as ``tests/test_device_suite.py`` does in CI):
     Device bytes per particle of the particle state and of the grid, elastic
     and Cam-Clay (and the device pool in use on CUDA).
 ``throughput``
-    ``throughput.py`` beside Taichi at about 1M, 4M and 16M particles, 2D and
+    ``throughput.py`` beside Taichi at about 1M and 4M particles, 2D and
     3D, elastic and plastic (``device_suite_throughput_<dev>.json``, rewritten
     after every configuration).
 ``pst``
     One production-resolution flat PST (:func:`run_pst_flat`, the one place
     that knows how to run it), with its wall time per simulated second.
+``field``
+    A small field batch (``mpm_warp.studies.field_columns``): 16 made-up field columns stepped together on the
+    device until each is decided, and the first alone on one CPU core: cases per hour both ways.
 """
 
 from __future__ import annotations
@@ -62,7 +65,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))     # the repository: its tests/ r
 
 #: Seconds each part may take: (full, quick). The full budgets sum to 450 s (< 8 min with start-up).
 BUDGETS = {"tests": (120, 60), "graph": (25, 40), "graph_deterministic": (25, 40), "memory": (15, 30),
-           "throughput": (205, 90), "pst": (60, 60)}
+           "throughput": (120, 90), "pst": (60, 60), "field": (85, 60)}
 PARTS = tuple(BUDGETS)
 #: Device-meaningful test modules, most telling first; the second group compares runs bit for bit.
 TEST_MODULES = ("test_transfer", "test_camclay", "test_camclay_large_strain", "test_bonded_camclay",
@@ -75,7 +78,7 @@ QUICK_TEST_MODULES = ("test_elasticity", "test_graph_batching")
 TEST_WORKERS = 8
 
 #: Throughput sizes (approximate particle counts) and steps per repeat.
-FULL_PARTICLES = (1.0e6, 4.0e6, 16.0e6)
+FULL_PARTICLES = (1.0e6, 4.0e6)
 QUICK_PARTICLES = (512.0,)
 
 
@@ -228,34 +231,20 @@ class _graph_stand_in:
 
 def part_memory(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
     """Bytes per particle of the particle state and of the grid, elastic and Cam-Clay, 3D and 2D."""
-    import warp as wp
+    from mpm_warp.studies.device_memory import bytes_per_particle
 
-    from mpm_warp.studies.blocks import block_simulation
+    return bytes_per_particle(device, quick)
 
-    rows = []
-    wp.init()
-    dev = wp.get_device(device)
-    for dim, material in ((3, "elastic"), (3, "plastic"), (2, "elastic"), (2, "plastic")):
-        n_grid = (24 if quick else 128) if dim == 3 else (24 if quick else 1448)
-        wp.synchronize_device(dev)
-        used0 = wp.get_mempool_used_mem_current(dev) if dev.is_cuda and wp.is_mempool_enabled(dev) else None
-        sim = block_simulation(dim, material, n_grid, device, n_threads=1)
-        N = sim.model.n_particles
-        st = sim.stepper
-        row = {"dim": dim, "material": material, "n_grid": n_grid, "n_particles": N,
-               "particle_state_bytes_per_particle": sim.model.bytes_per_particle(sim.state),
-               "grid_bytes_per_particle": (st.grid_m_all.capacity + st.grid_p_all.capacity) / N,
-               "grid_nodes": int(st.grid_m.size), "grid_copies": st.n_threads}
-        if used0 is not None:
-            row["device_pool_bytes_per_particle"] = (wp.get_mempool_used_mem_current(dev) - used0) / N
-        rows.append(row)
-        del sim, st
-    return {"device": device, "rows": rows,
-            "note": "taichi's counts are in the throughput rows (bytes_per_particle, grid_bytes_per_particle)"}
+
+def part_field(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
+    """A small field batch: 16 made-up columns stepped together on the device, the first alone on one CPU core."""
+    from mpm_warp.studies.field_columns import time_columns
+
+    return time_columns(device, 2 if quick else 16, 1, deadline - 30.0, quick)
 
 
 def part_throughput(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
-    """``throughput.run`` at 1M/4M/16M (quick: one tiny size), 2D and 3D, elastic and plastic, beside Taichi."""
+    """``throughput.run`` at 1M and 4M (quick: one tiny size), 2D and 3D, elastic and plastic, beside Taichi."""
     import throughput
 
     name = f"device_suite_throughput_{_tag(device, quick)}"
@@ -292,7 +281,7 @@ def part_pst(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
 
 PART_FUNCS = {"tests": part_tests, "graph": part_graph,
               "graph_deterministic": lambda *a: part_graph(*a, deterministic=True),
-              "memory": part_memory, "throughput": part_throughput, "pst": part_pst}
+              "memory": part_memory, "throughput": part_throughput, "pst": part_pst, "field": part_field}
 
 
 # ----------------------------------------------------------------------------------------- driver
