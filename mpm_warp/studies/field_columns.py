@@ -17,11 +17,11 @@ __all__ = ["made_up_columns", "time_columns"]
 
 def made_up_columns(n: int, quick: bool = False) -> list:
     """``n`` field-protocol scenarios of different columns (``quick``: 2 ms of each, for a smoke run)."""
-    import mpm_warp as mw
-    from mpm_warp.field.protocol import FieldProtocol, protocol_params
-    from mpm_warp.scenes.pst import build
+    from ..field.protocol import FieldProtocol, protocol_params
+    from ..loader import load_scenario
+    from ..scenes.pst import build
 
-    base = mw.load_scenario("pst_demo", ["scene.substratum_thickness=0.03", "scene.settle.gravity_ramp=0.02",
+    base = load_scenario("pst_demo", ["scene.substratum_thickness=0.03", "scene.settle.gravity_ramp=0.02",
                                     "scene.settle.duration=0.04"]).scene
     proto = FieldProtocol(pre_cut_share=0.0, frame_interval=0.005, tail=0.1)
     out = []
@@ -38,7 +38,7 @@ def made_up_columns(n: int, quick: bool = False) -> list:
 
 
 def _decided(k, sim, frame) -> bool:
-    from mpm_warp.field.protocol import decided
+    from ..field.protocol import decided
 
     return not decided(sim)
 
@@ -60,8 +60,8 @@ def time_columns(device: str, n: int, alone: int, deadline: float, quick: bool =
     """
     import warp as wp
 
-    from mpm_warp.column_batch import run_columns
-    from mpm_warp.runner import simulation_for
+    from ..column_batch import run_columns
+    from ..runner import simulation_for
 
     scenarios = made_up_columns(n, quick)
     warm = made_up_columns(2, quick=True)                       # compiles every kernel of the group (not timed)
