@@ -21,11 +21,9 @@ import sys
 import tempfile
 import warnings
 
-from slab_fe import MESHES
-from slab_fe import case_row as fe_row
-from slab_stress import case_row as stress_row
-
 from mpm_warp.field.batch import run_records
+from mpm_warp.field.studies.slab_fe import MESHES, fe_row
+from mpm_warp.field.studies.slab_stress import stress_row
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 

@@ -22,9 +22,8 @@ import sys
 import time
 import warnings
 
-from closure import BATCHES, scored_cases
-from slab_fe import fe_ratios
-
+from mpm_warp.field.studies.drawn import add_data_arguments, scored_cases
+from mpm_warp.field.studies.slab_fe import fe_ratios
 from mpm_warp.scenes.pst.static import static_column
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -36,8 +35,7 @@ PLANES = ("strain", "stress")
 
 def main(argv=None) -> int:
     p = parser(__doc__, "the first 3 cases")
-    p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
-    p.add_argument("--batches", nargs="+", default=list(BATCHES), help="field_batch.py JSONs (default: both committed)")
+    add_data_arguments(p, RESULTS)
     p.add_argument("--dx", type=float, default=0.01, help="element width (m, default 0.01)")
     args = p.parse_args(argv)
     if not 0.002 <= args.dx <= 0.05:

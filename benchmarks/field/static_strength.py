@@ -22,10 +22,9 @@ import sys
 import time
 import warnings
 
-from closure import BATCHES, scored_cases
-from strength import FACETED, faceted_share, weaker
-
 from mpm_warp.field.static_rule import weac_static_class
+from mpm_warp.field.studies.drawn import add_data_arguments, scored_cases
+from mpm_warp.field.studies.slab_strength import FACETED, faceted_share, weaker
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -35,8 +34,7 @@ RESULTS = os.path.join(HERE, "results")
 
 def main(argv=None) -> int:
     p = parser(__doc__, "the first 3 cases")
-    p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
-    p.add_argument("--batches", nargs="+", default=list(BATCHES), help="field_batch.py JSONs (default: both committed)")
+    add_data_arguments(p, RESULTS)
     p.add_argument("--faceted", type=float, default=0.5,
                    help="a faceted layer's (FC, DH) strength over the density law's (default 0.5, in situ)")
     args = p.parse_args(argv)
