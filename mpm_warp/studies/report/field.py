@@ -184,9 +184,9 @@ def _resolution(data: dict, ctx) -> list[str]:
     budget = (f" ({want - 1} where {want} would exceed the particle budget)" if want and str(want - 1) in n else "")
     res = ctx.load(RESOLUTION)
     if res and res.get("cases"):
-        same = sum(c["coarse"]["predicted"] == c["fine"]["predicted"] for c in res["cases"])
+        same = sum(c["before"]["predicted"] == c["after"]["predicted"] for c in res["cases"])
         said += (f" On field columns themselves, {same} of {len(res['cases'])} drawn cases kept their class at "
-                 f"{res['cells'][1]} cells across the weak layer "
+                 f"{res['switch']['value']} cells across the weak layer "
                  f"({ref('The grid: the same columns at 6 cells across the weak layer')}).")
     return ["", f"- **Resolution:** cells across the weak layer: {used}{budget}. " + said]
 
