@@ -147,3 +147,22 @@ def test_one_renderer_renders_any_what_if_result():
     assert any("balanced accuracy at 4 cells 0.50 (recall END 1.00, SF 0.00); at 6 cells 1.00" in ln for ln in out)
     passing = render_what_if(_result(cases[:1]))
     assert sum("**pass**" in ln for ln in passing) == 2
+
+
+def test_a_what_if_script_is_one_call_and_refuses_what_it_cannot_run(capsys):
+    from mpm_warp.studies.field_what_if import what_if_main
+
+    script = os.path.join(ROOT, "benchmarks", "field", "strength.py")
+    for argv, why in ((["DIR", "--scale", "0.5", "--faceted", "0.5"], "--scale and --faceted: one what-if a run"),
+                      (["DIR", "--faceted", "1.5"], "--faceted = 1.5 is invalid"),
+                      (["DIR", "--scale", "0"], "--scale = 0 is invalid")):
+        assert what_if_main("doc", script, ("slab_strength", "faceted_strength"), 8, argv) == 2
+        assert why in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:
+        what_if_main("doc", script, ("pre_cut_share",), 8, ["--help"])
+    assert stop.value.code == 0
+    out = capsys.readouterr().out
+    assert all(flag in out for flag in ("--quick", "--out", "--share", "--per-class", "--runs", "--batches"))
+    for name in ("closure", "rigid_base", "pre_cut", "resolution", "weak_modulus", "strength"):
+        with open(os.path.join(ROOT, "benchmarks", "field", name + ".py")) as fh:
+            assert "what_if_main(__doc__, __file__," in fh.read(), name

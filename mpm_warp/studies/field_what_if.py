@@ -1,9 +1,11 @@
 """The command line of a field what-if study: draw cases, run them with one switch changed, write the result.
 
-A script in ``benchmarks/field/`` adds :func:`add_what_if_arguments` to its parser (the data, the draw, the
-Dask batch and one option per switch it offers) and hands the parsed arguments to :func:`what_if_study`, which
-draws the committed batches' cases (:func:`~mpm_warp.field.studies.drawn.draw_rows`), runs the what-if
-(:func:`~mpm_warp.field.studies.what_if.run_what_if`) and writes its JSON in the what-if schema.
+A script in ``benchmarks/field/`` is its question (its docstring) and one call, :func:`what_if_main`: the
+protocol's options (``--quick``, ``--out``), the data, the draw, the Dask batch and one option per switch it
+offers (:func:`add_what_if_arguments`); :func:`what_if_study` draws the committed batches' cases
+(:func:`~mpm_warp.field.studies.drawn.draw_rows`), runs the what-if
+(:func:`~mpm_warp.field.studies.what_if.run_what_if`) and writes its JSON in the what-if schema, with the
+environment record taken before the runs, into the ``results`` folder beside the script.
 """
 
 from __future__ import annotations
@@ -15,10 +17,10 @@ import warnings
 from ..field.studies.drawn import add_draw_arguments, draw_rows
 from ..field.studies.switches import SWITCHES
 from ..field.studies.what_if import run_what_if
-from .environment import write_json
-from .protocol import out_dir
+from .environment import environment, write_json
+from .protocol import out_dir, parser
 
-__all__ = ["add_what_if_arguments", "chosen_switch", "what_if_study"]
+__all__ = ["what_if_main", "add_what_if_arguments", "chosen_switch", "what_if_study"]
 
 
 def _dest(flag: str) -> str:
@@ -77,3 +79,15 @@ def what_if_study(args, names: tuple[str, ...], name: str, results: str, env: di
     path = write_json(name, data, dest)
     print(f"{path}: {len(rows)} cases")
     return 0
+
+
+def what_if_main(doc: str, script: str, names: tuple[str, ...], per_class: int, argv=None) -> int:
+    """The whole command line of the what-if script ``script`` (its ``__file__``; ``doc``, its docstring): the
+    switches ``names`` (the first without an option), ``per_class`` cases a class by default. Its JSON is
+    ``field_<script's stem>.json`` in ``results/`` beside it (or ``--out``). Returns the exit status."""
+    p = parser(doc, "one case of at most 20 s")
+    results = os.path.join(os.path.dirname(os.path.abspath(script)), "results")
+    add_what_if_arguments(p, names, per_class, results)
+    args = p.parse_args(argv)
+    name = "field_" + os.path.splitext(os.path.basename(script))[0]
+    return what_if_study(args, names, name, results, environment("cpu"))

@@ -5,7 +5,7 @@ from __future__ import annotations
 from statistics import median
 
 from .core import section
-from .field_what_if import command, cut, failed_lines, labels, render_what_if
+from .field_what_if import command, cut, failed_lines, render_what_if
 from .fmt import fx
 
 #: m: a runaway cut this close to the pre-cut is the pre-cut's own: the crack ran from where the run started it
@@ -42,19 +42,12 @@ def _notes(data: dict) -> list[str]:
     return _at_pre_cut(data) + _cost(data)
 
 
-def _intro(data: dict) -> str:
-    b, a = labels(data)
-    return (f"Cases: {data['chosen']}, each run again with the saw's pre-cut (`scene.saw.pre_cut`, a share of weac's "
-            "critical cut of the column at its fracture energy, at most half the column) changed, nothing else. "
-            f"Each pair of values is {b} / {a}.")
-
-
 @section("field", "The pre-cut: the same columns started sawn", "field/results/field_pre_cut.json",
          command("pre_cut", lambda d: f" --share {d['switch']['value']:g}"),
          follows="The rigid base: the same columns without their old snow",
          question="Does starting a field column sawn part of the way to weac's critical cut change its outcome, "
                   "and what does it save?")
 def render_pre_cut(data: dict, ctx) -> list[str]:
-    return render_what_if(data, ctx, intro=_intro, notes=(_notes,),
+    return render_what_if(data, ctx, notes=(_notes,),
                           columns=("critical_cut", "pre_cut", "predicted", "runaway", "change", "broke", "steps",
                                    "wall"))
