@@ -256,20 +256,23 @@ def test_the_plane_stress_check_fails_where_one_column_moves_beyond_its_bound():
 
 
 def _modulus_case(observed, scene, softer, status="ok"):
-    return {"test": f"PST {observed}", "observed": observed,
-            "scene": {"status": "ok", "predicted": scene, "static_class": "END", "w_f": 0.3, "w_f_source": "read back",
-                      "runaway_cut": 0.3, "steps": 10, "wall_s": 1.0},
-            "softer": {"status": status, "predicted": softer if status == "ok" else None, "static_class": "END",
-                       "w_f": 0.6, "w_f_source": "read back", "runaway_cut": 0.3, "slab_fracture_at": None,
-                       "steps": 12, "wall_s": 1.0, "error": None if status == "ok" else "p: PST 1/2 (SF) down 3 cm: x"}}
+    def side(predicted, st, w_f, error=None):
+        return {"status": st, "predicted": predicted, "static_class": "END", "w_f": w_f, "w_f_source": "read back",
+                "runaway_cut": 0.3, "slab_fracture_at": None, "error": error,
+                "cost": {"steps": 10, "wall_s": 1.0}}
+
+    return {"test": f"PST {observed}", "observed": observed, "setup": None, "before": side(scene, "ok", 0.3),
+            "after": side(softer if status == "ok" else None, status, 0.6,
+                          None if status == "ok" else "p: PST 1/2 (SF) down 3 cm: x")}
 
 
 def test_the_weak_modulus_check_asks_for_more_sf_among_the_sf_records_beyond_chance():
     from mpm_warp.studies.report.field_weak_modulus import render_weak_modulus
 
     def lines(cases):
-        data = {"scene_modulus_mpa": 1.0, "modulus_mpa": 0.25, "chosen": "n drawn", "per_class": 8, "seed": 0,
-                "max_wall_s": 120, "workers": 2, "threads": 1, "cases": cases, "environment": {}}
+        data = {"switch": {"name": "weak_modulus", "value": 0.25, "before": 1.0}, "chosen": "n drawn",
+                "per_class": 8, "seed": 0, "max_wall_s": 120, "workers": 2, "threads": 1, "cases": cases,
+                "environment": {}}
         return render_weak_modulus(data, None)
 
     def check(cases):
@@ -286,5 +289,5 @@ def test_the_weak_modulus_check_asks_for_more_sf_among_the_sf_records_beyond_cha
     # a column the softer layer refuses is said in field terms and left out of the counts
     out = lines(few + [_modulus_case("SF", "END", None, status="refused")])
     assert "SF records 2 of 4 (0)" in [ln for ln in out if ln.startswith("- **Check, ")][0]
-    assert any(ln.startswith("- Not run on the softer layer (1): `PST SF` (SF): x.") for ln in out)
+    assert any(ln.startswith("- Not run at 0.25 MPa (1): `PST SF` (SF): x.") for ln in out)
     assert any("2.00 times the scene's (median; 2.00 to 2.00)" in ln for ln in out)

@@ -21,11 +21,9 @@ import sys
 import tempfile
 import warnings
 
-from slab_fe import MESHES
-from slab_fe import case_row as fe_row
-from slab_stress import case_row as stress_row
-
 from mpm_warp.field.batch import run_records
+from mpm_warp.field.studies.slab_fe import MESHES, fe_row
+from mpm_warp.field.studies.slab_stress import stress_row
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -44,8 +42,8 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
     draw = json.load(open(args.draw))
-    wanted = {c["closure_id"]: c for c in draw["cases"] if c["observed"] in ("SF", "END")
-              and c["on"].get("status") == "ok"}
+    wanted = {c["after_id"]: c for c in draw["cases"] if c["observed"] in ("SF", "END")
+              and c["after"].get("status") == "ok"}
     recs = sorted(((r, d) for r, d in run_records([args.runs]) if r["id"] in wanted), key=lambda rd: rd[0]["wall_s"])
     if len(recs) < len(wanted):
         print(f"error: runs: {len(wanted) - len(recs)} of the draw's cases have no finished run in {args.runs}",

@@ -4,7 +4,7 @@ The model says END once the damage front enters the far end zone, one slab thick
 (docs/model.md; there the slab's free end lifts the layer). Where the crack runs away within a slab thickness of
 the end, END is called as soon as it runs; an observer writes END only if the crack reaches the end and ARR if it
 stops short of it. This study draws cases as
-``closure.py`` does (``--per-class`` of each observed class, ``--seed``, among the committed batches' cases of at
+the what-if studies do (``--per-class`` of each observed class, ``--seed``, among the committed batches' cases of at
 most ``--max-wall`` s), keeps those the batch predicted END, sets each up again from its pit (its id's digest must
 match the batch's) and runs it by the field protocol, nothing changed, past the END call: until the damage front
 reaches the last ``--end-bins`` bins of the column (the crack reached the end), or stands still for the
@@ -27,10 +27,9 @@ import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
 
-from closure import add_draw_arguments, batch_cases, draw
-
 from mpm_warp.field.batch import case_scenario
 from mpm_warp.field.protocol import FieldProtocol
+from mpm_warp.field.studies.drawn import add_draw_arguments, batch_cases, draw_rows
 from mpm_warp.io.records import write_record
 from mpm_warp.scenes.pst.analysis import end_zone
 from mpm_warp.scenes.pst.outcome import STALL_TIME, front_stalled
@@ -90,13 +89,13 @@ def _one(task: dict) -> dict:
 
 def main(argv=None) -> int:
     p = parser(__doc__, "one case of at most 20 s")
-    add_draw_arguments(p, "past the END call", per_class=16)
+    add_draw_arguments(p, "past the END call", 16, RESULTS)
     p.add_argument("--end-bins", type=int, default=2, help="the crack reached the end within this many bins (2)")
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
     env = environment("cpu")
     cap = 20.0 if args.quick else args.max_wall
-    chosen, pool = draw(args.batches, args.per_class, args.seed, cap)
+    chosen, pool = draw_rows(args.batches, args.per_class, args.seed, cap)
     ends = [c for c in chosen if c["predicted"] == "END"][: 1 if args.quick else None]
     proto = FieldProtocol().validate()
     cases = batch_cases(args.data, ends, proto)

@@ -19,55 +19,41 @@ from __future__ import annotations
 
 import os
 import sys
-import time
-import warnings
 
-from closure import BATCHES, scored_cases
-from slab_fe import fe_ratios
-
+from mpm_warp.field.studies.drawn import add_data_arguments
+from mpm_warp.field.studies.slab_fe import fe_ratios
 from mpm_warp.scenes.pst.static import static_column
-from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.studies.environment import environment
+from mpm_warp.studies.field_static import static_study
+from mpm_warp.studies.protocol import parser
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-RESULTS = os.path.join(HERE, "results")
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 PLANES = ("strain", "stress")
 
 
 def main(argv=None) -> int:
     p = parser(__doc__, "the first 3 cases")
-    p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
-    p.add_argument("--batches", nargs="+", default=list(BATCHES), help="field_batch.py JSONs (default: both committed)")
+    add_data_arguments(p, RESULTS)
     p.add_argument("--dx", type=float, default=0.01, help="element width (m, default 0.01)")
     args = p.parse_args(argv)
     if not 0.002 <= args.dx <= 0.05:
         print(f"error: --dx = {args.dx:g} is invalid: expected 0.002-0.05 m", file=sys.stderr)
         return 2
-    warnings.filterwarnings("ignore")
-    env = environment("cpu")
-    t0 = time.perf_counter()
-    scored = scored_cases(args.batches, args.data, 3 if args.quick else None)
-    if scored is None:
-        return 2
-    chosen, cases = scored
-    out = []
-    for b, case in zip(chosen, cases, strict=True):
-        col = static_column(case.params)
-        strengths = [ly.strength for ly in case.params.slab_stack()]
-        cut = float(case.params.saw.cut_length)
-        fe = {plane: fe_ratios(col, strengths, cut, args.dx, plane) for plane in PLANES}
-        out.append({"id": b["id"], "test": b["test"], "observed": b["observed"], "predicted": b["predicted"],
-                    "static_class": b.get("static_class"), "cut": cut, "length": col.length,
-                    "slab_depth": sum(ly[0] for ly in col.slab), "fe": fe})
-        print(f"{b['test']} ({b['observed']}): peak {fe['strain']['peak']:.3f} (strain), "
-              f"{fe['stress']['peak']:.3f} (stress)", flush=True)
-    wall = time.perf_counter() - t0
-    data = {"name": "field_plane_stress", "dx": args.dx, "planes": list(PLANES),
-            "batches": [os.path.relpath(b, HERE) for b in args.batches], "wall_s": wall, "environment": env,
-            "cases": out}
-    path = write_json("field_plane_stress", data, out_dir(args, RESULTS, "field_plane_stress"))
-    print(f"{path}: {len(out)} cases in {wall:.0f} s")
-    return 0
+    return static_study(args, "field_plane_stress", RESULTS, lambda b, case: _row(b, case, args.dx),
+                        {"dx": args.dx, "planes": list(PLANES)}, environment("cpu"))
+
+
+def _row(b: dict, case, dx: float) -> dict:
+    """The FE of one scored case at its recorded cut in both plane limits."""
+    col = static_column(case.params)
+    strengths = [ly.strength for ly in case.params.slab_stack()]
+    cut = float(case.params.saw.cut_length)
+    fe = {plane: fe_ratios(col, strengths, cut, dx, plane) for plane in PLANES}
+    print(f"{b['test']} ({b['observed']}): peak {fe['strain']['peak']:.3f} (strain), "
+          f"{fe['stress']['peak']:.3f} (stress)", flush=True)
+    return {"id": b["id"], "test": b["test"], "observed": b["observed"], "predicted": b["predicted"],
+            "static_class": b.get("static_class"), "cut": cut, "length": col.length,
+            "slab_depth": sum(ly[0] for ly in col.slab), "fe": fe}
 
 
 if __name__ == "__main__":

@@ -20,129 +20,26 @@ from __future__ import annotations
 import json
 import os
 import sys
-import time
 import warnings
 
-import numpy as np
-
 from mpm_warp.field.batch import run_records
-from mpm_warp.io.checkpoint import read_checkpoint_meta
-from mpm_warp.loader import resolved_scenario
+from mpm_warp.field.studies.slab_fe import CORNER_M, MESHES, compare, fe_row
+from mpm_warp.field.studies.slab_stress import control_params
 from mpm_warp.scenes.pst.static import static_column
-from mpm_warp.scenes.weac_reference import slab_stress
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
-from mpm_warp.validation.column_fe import solve_column
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
 STUDIES = (os.path.join(RESULTS, "field_slab_stress.json"), os.path.join(RESULTS, "end", "field_slab_stress.json"))
 
-#: m: stresses this close to the corner where the sawn weak layer ends (the crack tip at the slab's base) or to
-#: the column's end faces (where layer interfaces and the weak layer meet a free face) are reported apart: there
-#: linear elasticity is singular, the value grows with refinement, and a run's grid (5-8 mm) smears the same zone
-CORNER_M = 0.02
-#: element widths (m): the solution and its refinement
-MESHES = (0.01, 0.005)
-
-
-def fe_ratios(column, strengths, cut: float, dx: float, plane: str = "strain") -> dict:
-    """The FE's slab stress over strength at ``cut`` (m) on elements of ``dx`` (m), in plane strain or plane stress:
-    the peak away from the crack tip's corner and the end faces (and where: x from the cut end, depth, layer,
-    sigma_xx, sigma_zz, sigma_xz), per layer, and in those edge zones (``edges``)."""
-    t0 = time.perf_counter()
-    r = solve_column(column.slab, (column.weak_layer_thickness, column.weak_layer_E, column.weak_layer_nu),
-                     column.length, cut, slope_angle=column.slope_angle, cut_from=column.cut_from,
-                     column_ends=column.column_ends, dx=dx, plane=plane)
-    slab = r.layer >= 0
-    ratio = np.where(slab, r.sigma_1 / np.asarray(strengths)[np.maximum(r.layer, 0)], -np.inf)
-    slab_depth = sum(ly[0] for ly in column.slab)
-    near = ((np.hypot(r.x - cut, r.depth - slab_depth) < CORNER_M) | (r.from_end_face < CORNER_M)
-            | (r.from_end_face > column.length - CORNER_M))
-    far = slab & ~near
-    i = int(np.argmax(np.where(far, ratio, -np.inf)))
-    return {"dx": dx, "dofs": int(r.dofs), "peak": float(ratio[i]),
-            "peak_at": {"x": float(r.x[i]), "depth": float(r.depth[i]), "layer": int(r.layer[i]),
-                        "sigma": [float(v) for v in r.sigma[i]]},
-            "over_cut": float(ratio[far & (r.x < cut)].max()) if np.any(far & (r.x < cut)) else None,
-            "layers": [float(ratio[far & (r.layer == k)].max()) for k in range(len(column.slab))],
-            "edges": float(ratio[slab & near].max()), "wall_s": time.perf_counter() - t0}
-
-
-def weac_ratios(column, strengths, cut: float) -> dict:
-    """weac's static slab stress over strength at ``cut``: over the cut and at the tip (as ``slab_stress.py``)."""
-    st = slab_stress(column, cut, strengths, dx=0.005, dz=0.002)
-    over = st["ratio"][:, st["cracked"]]
-    tip = st["ratio"][:, np.isclose(st["x"], cut, rtol=0.0, atol=1e-9)]
-    return {"over_cut": float(over.max()) if over.size else None, "tip": float(tip.max()),
-            "peak": float(st["peak_ratio"]), "peak_layer": int(st["peak_ratio_layer"])}
-
-
-def compare(column, strengths, cut: float, meshes=MESHES) -> dict:
-    fe = [fe_ratios(column, strengths, cut, dx) for dx in meshes]
-    change = fe[-1]["peak"] / fe[0]["peak"] - 1.0 if len(fe) > 1 else None
-    return {"cut": cut, "fe": fe, "fe_refinement_change": change, "weac": weac_ratios(column, strengths, cut)}
-
 
 def control(study: dict, meshes) -> dict:
     """The homogeneous control of ``slab_stress.py`` (its cuts and its run's values) solved by the FE."""
-    from mpm_warp.scenes.pst import PSTParams
-    from mpm_warp.scenes.pst.saw import Saw
-    from mpm_warp.scenes.snowpack import SnowLayer
-
-    p = PSTParams(length=2.0, slab_layers=(SnowLayer(0.2, 120.0),), slab_fracture=True,
-                  saw=Saw(cut_length=0.36, speed=1.0))
+    p = control_params()
     col, strengths = static_column(p), [ly.strength for ly in p.slab_stack()]
-    rows = []
-    for row in study["control"]["rows"]:
-        c = compare(col, strengths, row["cut"], meshes)
-        rows.append({**c, "run": row["run"]})
+    rows = [{**compare(col, strengths, row["cut"], meshes), "run": row["run"]} for row in study["control"]["rows"]]
     return {"what": study["control"]["what"], "slab_depth_m": study["control"]["slab_depth_m"], "rows": rows}
-
-
-def run_layers_to(case: dict, cut: float | None, last: bool = False) -> list | None:
-    """The run's largest stress over strength in each slab layer (top to bottom) while the blade had cut at most
-    ``cut`` (m), from the slab-stress study's frames; ``last``: in the last such frame only."""
-    s = case["series"]
-    rows = [r for saw, r in zip(s["saw"], s["ratio"], strict=True) if cut is not None and saw <= cut + 1e-9]
-    if not rows:
-        return None
-    return [float(v) for v in (rows[-1] if last else np.max(rows, axis=0))]
-
-
-def run_peak_at_onset(case: dict, column, cut: float | None) -> dict | None:
-    """Where the run's slab peak sat in the onset frame (the slab-stress study's ``peak_at``): along the column from
-    the cut end's face at its depth (m), depth (m), the stresses (Pa), and its zone: ``blade`` (within
-    :data:`CORNER_M` of the blade along the column), ``end face`` (of either end face), else ``inside``."""
-    s = case["series"]
-    if cut is None or not s.get("peak_at"):
-        return None
-    k = max(i for i, saw in enumerate(s["saw"]) if saw <= cut + 1e-9)
-    x0, depth, sxx, syy, sxy = s["peak_at"][k]
-    h = sum(ly[0] for ly in column.slab)
-    shear = -np.tan(np.radians(column.slope_angle)) if column.column_ends == "vertical" else 0.0
-    from_face = x0 - shear * (h - depth)                    # from the upslope end's face at that depth
-    if column.cut_from == "downslope":
-        from_face = column.length - from_face
-    zone = ("blade" if abs(from_face - s["saw"][k]) <= CORNER_M else
-            "end face" if min(from_face, column.length - from_face) <= CORNER_M else "inside")
-    return {"from_end_face": float(from_face), "depth": float(depth), "sigma": [sxx, syy, sxy], "zone": zone,
-            "blade": float(s["saw"][k])}
-
-
-def case_row(case: dict, run_dir: str, meshes) -> dict:
-    ck = os.path.join(run_dir, case["id"] + ".ckpt.h5")
-    p = resolved_scenario(read_checkpoint_meta(ck)["scenario"], source=ck).scene
-    col, strengths = static_column(p), [ly.strength for ly in p.slab_stack()]
-    row = {"id": case["id"], "test": case["test"], "observed": case["observed"], "slope_deg": p.slope_angle,
-           "column_ends": col.column_ends, "length_m": col.length, "slab_depth_m": p.slab_depth, "run_dx": p.dx,
-           "layer_cells": [ly["cells"] for ly in case["layers"]], "onset_cut": case["onset_cut"],
-           "run_to_onset": case["mpm_ratio_to_onset"], "run_layers_to_onset": run_layers_to(case, case["onset_cut"]),
-           "run_layers_at_onset": run_layers_to(case, case["onset_cut"], last=True),
-           "run_peak_at": case.get("peak_at"), "run_peak_at_onset": run_peak_at_onset(case, col, case["onset_cut"])}
-    if case["onset_cut"]:
-        row["at_onset"] = compare(col, strengths, case["onset_cut"], meshes)
-    return row
 
 
 def main(argv=None) -> int:
@@ -172,7 +69,7 @@ def main(argv=None) -> int:
         return 2
     data["cases"] = []
     for c, sel in cases[:1] if args.quick else cases:
-        row = {**case_row(c, where[c["id"]], meshes), "selection": sel}
+        row = {**fe_row(c, where[c["id"]], meshes), "selection": sel}
         data["cases"].append(row)
         path = write_json("field_slab_fe", data, dest)
         o = row.get("at_onset")

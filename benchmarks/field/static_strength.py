@@ -19,51 +19,36 @@ from __future__ import annotations
 
 import os
 import sys
-import time
-import warnings
-
-from closure import BATCHES, scored_cases
-from strength import FACETED, faceted_share, weaker
 
 from mpm_warp.field.static_rule import weac_static_class
-from mpm_warp.studies.environment import environment, write_json
-from mpm_warp.studies.protocol import out_dir, parser
+from mpm_warp.field.studies.drawn import add_data_arguments
+from mpm_warp.field.studies.slab_strength import FACETED, faceted_share, weaker
+from mpm_warp.studies.environment import environment
+from mpm_warp.studies.field_static import static_study
+from mpm_warp.studies.protocol import parser
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-RESULTS = os.path.join(HERE, "results")
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 
 def main(argv=None) -> int:
     p = parser(__doc__, "the first 3 cases")
-    p.add_argument("data", help="folder of CAAML files (the unpacked development set)")
-    p.add_argument("--batches", nargs="+", default=list(BATCHES), help="field_batch.py JSONs (default: both committed)")
+    add_data_arguments(p, RESULTS)
     p.add_argument("--faceted", type=float, default=0.5,
                    help="a faceted layer's (FC, DH) strength over the density law's (default 0.5, in situ)")
     args = p.parse_args(argv)
     if not 0.0 < args.faceted <= 1.0:
         print(f"error: --faceted = {args.faceted:g} is invalid: expected a factor in (0, 1]", file=sys.stderr)
         return 2
-    warnings.filterwarnings("ignore")
-    env = environment("cpu")
-    t0 = time.perf_counter()
-    scored = scored_cases(args.batches, args.data, 3 if args.quick else None)
-    if scored is None:
-        return 2
-    chosen, cases = scored
-    out = []
-    for b, case in zip(chosen, cases, strict=True):
-        law = weac_static_class(case.params)
-        grain = weac_static_class(weaker(case, 1.0, args.faceted).params)
-        out.append({"id": b["id"], "test": b["test"], "observed": b["observed"], "predicted": b["predicted"],
-                    "faceted_share": faceted_share(case.params), "static_batch": b.get("static_class"),
-                    "static_law": law, "static_grain": grain})
-    wall = time.perf_counter() - t0
-    data = {"name": "field_static_strength", "faceted": args.faceted, "faceted_grains": list(FACETED),
-            "batches": [os.path.relpath(b, HERE) for b in args.batches], "wall_s": wall, "environment": env,
-            "cases": out}
-    path = write_json("field_static_strength", data, out_dir(args, RESULTS, "field_static_strength"))
-    print(f"{path}: {len(out)} cases in {wall:.0f} s")
-    return 0
+    return static_study(args, "field_static_strength", RESULTS, lambda b, case: _row(b, case, args.faceted),
+                        {"faceted": args.faceted, "faceted_grains": list(FACETED)}, environment("cpu"))
+
+
+def _row(b: dict, case, facets: float) -> dict:
+    """weac's static class of one scored case at the law's strength and with its faceted layers at ``facets``."""
+    return {"id": b["id"], "test": b["test"], "observed": b["observed"], "predicted": b["predicted"],
+            "faceted_share": faceted_share(case.params), "static_batch": b.get("static_class"),
+            "static_law": weac_static_class(case.params),
+            "static_grain": weac_static_class(weaker(case, 1.0, facets).params)}
 
 
 if __name__ == "__main__":

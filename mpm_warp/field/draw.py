@@ -12,7 +12,7 @@ import random
 
 from .scores import FIELD_CLASSES, field_class
 
-__all__ = ["all_measured", "select", "finished_draw"]
+__all__ = ["all_measured", "sample_per_class", "select", "finished_draw"]
 
 
 def all_measured(case) -> bool:
@@ -20,18 +20,22 @@ def all_measured(case) -> bool:
     return all(p.measured for p in case.column.slab)
 
 
+def sample_per_class(items, per_class: int, seed: int, class_of) -> list[list]:
+    """A seeded sample of ``per_class`` of ``items`` (fewer where fewer) for each observed class, in the order of
+    :data:`FIELD_CLASSES` (END, SF, ARR): one list a class. ``class_of(item)`` is an item's observed class; one
+    ``random.Random(seed)`` draws the classes in turn, so the same items and seed give the same sample."""
+    rng = random.Random(seed)
+    return [rng.sample(of, min(per_class, len(of))) for of in
+            ([x for x in items if class_of(x) == cls] for cls in FIELD_CLASSES)]
+
+
 def select(cases, per_class: int, seed: int, measured: bool = True) -> tuple[list, dict]:
     """The measured-density columns (when ``measured``) and a seeded sample of ``per_class`` per observed class,
     interleaved; and the counts drawn (``measured``, ``END``, ``SF``, ``ARR``)."""
     chosen = [c for c in cases if measured and all_measured(c)]
     rest = [c for c in cases if not (measured and all_measured(c))]
-    rng = random.Random(seed)
-    counts = {"measured": len(chosen)}
-    takes = []
-    for cls in FIELD_CLASSES:
-        pool = [c for c in rest if field_class(c.outcome) == cls]
-        takes.append(rng.sample(pool, min(per_class, len(pool))))
-        counts[cls] = len(takes[-1])
+    takes = sample_per_class(rest, per_class, seed, lambda c: field_class(c.outcome))
+    counts = {"measured": len(chosen), **{cls: len(t) for cls, t in zip(FIELD_CLASSES, takes, strict=True)}}
     chosen += [t[k] for k in range(max(map(len, takes), default=0)) for t in takes if k < len(t)]
     return chosen, counts
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from statistics import median
 
+from ...scenes.pst.outcome import FIELD_CLASSES
 from .convergence import field_level_errors
 from .core import section
 from .fmt import count, env_note, fx, pct, secs, spct, table
@@ -119,7 +120,7 @@ def _judged(data: dict) -> bool:
     """Whether the batch ran its whole draw of at least 150 columns: every drawn column was run or refused in field
     terms when built (a refusal is the protocol's answer for that column, not a case left out)."""
     sel = data["selection"]
-    drawn = sum(sel.get(k, 0) for k in ("measured", "END", "SF", "ARR"))
+    drawn = sum(sel.get(k, 0) for k in ("measured", *FIELD_CLASSES))
     refused = len(data.get("refused_at_build") or [])
     return not sel.get("finished_only") and drawn >= 150 and data["scores"]["cases"] + refused >= drawn
 
@@ -184,9 +185,9 @@ def _resolution(data: dict, ctx) -> list[str]:
     budget = (f" ({want - 1} where {want} would exceed the particle budget)" if want and str(want - 1) in n else "")
     res = ctx.load(RESOLUTION)
     if res and res.get("cases"):
-        same = sum(c["coarse"]["predicted"] == c["fine"]["predicted"] for c in res["cases"])
+        same = sum(c["before"]["predicted"] == c["after"]["predicted"] for c in res["cases"])
         said += (f" On field columns themselves, {same} of {len(res['cases'])} drawn cases kept their class at "
-                 f"{res['cells'][1]} cells across the weak layer "
+                 f"{res['switch']['value']} cells across the weak layer "
                  f"({ref('The grid: the same columns at 6 cells across the weak layer')}).")
     return ["", f"- **Resolution:** cells across the weak layer: {used}{budget}. " + said]
 

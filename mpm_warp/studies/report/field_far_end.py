@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from .core import section
-from .field_closure import CLASSES
+from .field_what_if import CLASSES
 from .fmt import check_line, count, env_note, fx, table
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 from statistics import median
 
 from .core import section
-from .field_closure import CLASSES
+from .field_what_if import CLASSES
 from .fmt import check_line, env_note, fx, pct, spct, table
 
 #: the largest change of the slab's peak stress between the two limits the check allows (-)

@@ -8,15 +8,15 @@ import os
 from statistics import median
 
 from .core import section
-from .field_closure import CLASSES, _balanced
-from .field_rigid_base import _cut
-from .fmt import check_line, count, env_note, fx, pct, spct, table
+from .field_what_if import CLASSES, COLUMNS, balanced, balanced_line, command, failed_lines, ran, render_what_if
+from .fmt import check_line, env_note, fx, pct, spct, table
 
 
-def _to_sf(cases: list, cls: str, side: str) -> tuple[int, int]:
-    """Of the cases observed ``cls`` that ran: how many ``side`` predicted SF, of how many."""
+def sf_counts(cases: list, cls: str, side: str, key: str = "predicted") -> tuple[int, int]:
+    """Of the cases observed ``cls``: how many ``side`` (``before`` or ``after``) says SF under ``key``, of how
+    many."""
     of = [c for c in cases if c["observed"] == cls]
-    return sum(c[side]["predicted"] == "SF" for c in of), len(of)
+    return sum(c[side][key] == "SF" for c in of), len(of)
 
 
 #: the section's own run: the largest draw, at a quarter of the law's strength
@@ -26,6 +26,9 @@ FACETED = "field/results/strength/faceted_0.5_16/field_strength.json"
 #: smaller draws (8 a class, the same seed: a draw of its own) at both factors, summarised beside it
 MORE = (FACETED, "field/results/strength/0.5_8/field_strength.json",
         "field/results/strength/0.25_8/field_strength.json")
+_VERDICT = {None: "; too few cases to tell", True: "", False: "; no larger share of the SF records"}
+_CRITERION = ("a larger share of the SF records than of the END records predicted SF, beyond chance (one-sided "
+              "Fisher exact test, p <= 0.05)")
 
 
 def sf_verdict(a: int, n: int, b: int, m: int) -> tuple[float | None, bool | None]:
@@ -36,32 +39,37 @@ def sf_verdict(a: int, n: int, b: int, m: int) -> tuple[float | None, bool | Non
     return p, None if p is None else True if p <= 0.05 else (False if a / n <= b / m else None)
 
 
-def _check(label: str, row: list, p: float | None, passed: bool | None) -> str:
-    """The pass line of one factor's row (:func:`sf_verdict`)."""
-    return check_line(label, "a larger share of the SF records than of the END records predicted SF, beyond chance "
-                             "(one-sided Fisher exact test, p <= 0.05)", passed,
-                      f"SF records {row[3]}, END records {row[2]}, ARR records {row[4]}, the law's strength in "
-                      f"brackets; p = {row[6]}" + {None: "; too few cases to tell", True: "",
-                                                   False: "; no larger share of the SF records"}[passed])
+def sf_check(data: dict, label: str, was: str) -> str:
+    """The check that the what-if sends a larger share of the SF records than of the END records to SF, beyond
+    chance, over the cases run both ways: each class's count after, before in brackets (``was`` says what that
+    is)."""
+    cases = ran(data["cases"])
+    got = {cls: sf_counts(cases, cls, "after") for cls in CLASSES}
+    before = {cls: sf_counts(cases, cls, "before") for cls in CLASSES}
+    (a, n), (b, m) = got["SF"], got["END"]
+    p, passed = sf_verdict(a, n, b, m)
+    return check_line(label, _CRITERION, passed,
+                      ", ".join(f"{cls} records {got[cls][0]} of {got[cls][1]} ({before[cls][0]})" for cls in CLASSES)
+                      + f", {was} in brackets; p = {fx(p, 2)}" + _VERDICT[passed])
 
 
 def _faceted_lines(data: dict) -> list[str]:
     """What the faceted draw adds: the faceted share of the slabs per observed class and weac's static rule with
     the same strengths."""
-    ran = [c for c in data["cases"] if c["scaled"].get("status") == "ok"]
+    cases = ran(data["cases"])
     shares, static = [], []
     for cls in CLASSES:
-        of = [c for c in ran if c["observed"] == cls]
+        of = [c for c in cases if c["observed"] == cls]
         if of:
-            share = median(c["faceted_share"] for c in of)
-            anyf = sum(c["faceted_share"] > 0 for c in of)
+            share = median(c["detail"]["faceted_share"] for c in of)
+            anyf = sum(c["detail"]["faceted_share"] > 0 for c in of)
             shares.append(f"{cls} {pct(share, 0)} ({anyf} of {len(of)} with any)")
-            static.append(f"{cls} {sum(c['scaled']['static_class'] == 'SF' for c in of)} of {len(of)} "
-                          f"({sum(c['law']['static_class'] == 'SF' for c in of)})")
-    moved = sum(c["scaled"]["predicted"] != c["law"]["predicted"] for c in ran)
+            static.append(f"{cls} {sf_counts(of, cls, 'after', 'static_class')[0]} of {len(of)} "
+                          f"({sf_counts(of, cls, 'before', 'static_class')[0]})")
+    moved = sum(c["after"]["predicted"] != c["before"]["predicted"] for c in cases)
     return [f"- With only the faceted layers (primary grain {', '.join(data['faceted_grains'])}) at "
-            f"{fx(data['faceted'], 2)} of the law's strength, {moved} of the {len(ran)} runs changed their class. "
-            "The slab's faceted share of its thickness, median by "
+            f"{fx(data['switch']['value'], 2)} of the law's strength, {moved} of the {len(cases)} runs changed their "
+            "class. The slab's faceted share of its thickness, median by "
             f"observed class, {'; '.join(shares)}. weac's static rule with the same strengths predicts SF in "
             f"{'; '.join(static)} records (at the law's strength in brackets).", ""]
 
@@ -76,90 +84,73 @@ def fisher_greater(a: int, n: int, b: int, m: int) -> float:
 
 def _factor(data: dict) -> str:
     """The strength over the law's: ``"0.25"``, or ``"faceted layers 0.50"`` where only those were weakened."""
-    f = data.get("faceted", 1.0)
-    return fx(data["scale"], 2) if f == 1.0 else (
-        f"faceted layers {fx(f, 2)}" + ("" if data["scale"] == 1.0 else f", all {fx(data['scale'], 2)}"))
+    s = data["switch"]
+    return fx(s["value"], 2) if s["name"] == "slab_strength" else f"faceted layers {fx(s['value'], 2)}"
 
 
 def _summary(data: dict) -> list:
     """The row of one factor: SF predicted per observed class (new against the law's), the balanced accuracy,
     and Fisher's p of SF records against END records."""
-    ran = [c for c in data["cases"] if c["scaled"].get("status") == "ok"]
-    cells, got = [], {}
-    for cls in CLASSES:
-        k, n = _to_sf(ran, cls, "scaled")
-        k0, _ = _to_sf(ran, cls, "law")
-        got[cls] = (k, n)
-        cells.append(f"{k} of {n} ({k0})")
-    ba, _ = _balanced(ran, "scaled")
+    cases = ran(data["cases"])
+    got = {cls: sf_counts(cases, cls, "after") for cls in CLASSES}
+    cells = [f"{got[cls][0]} of {got[cls][1]} ({sf_counts(cases, cls, 'before')[0]})" for cls in CLASSES]
     (a, n), (b, m) = got["SF"], got["END"]
     p, passed = sf_verdict(a, n, b, m)
-    row = [_factor(data), str(data["per_class"]), *cells, fx(ba, 2), fx(p, 2)]
-    return row, p, passed
+    return [_factor(data), str(data["per_class"]), *cells, fx(balanced(cases, "after")[0], 2), fx(p, 2)], p, passed
+
+
+def _check(label: str, row: list, p: float | None, passed: bool | None) -> str:
+    """The pass line of one factor's row (:func:`_summary`)."""
+    return check_line(label, _CRITERION, passed, f"SF records {row[3]}, END records {row[2]}, ARR records {row[4]}, "
+                      f"the law's strength in brackets; p = {row[6]}" + _VERDICT[passed])
+
+
+def _factors(data: dict, ctx) -> list[str]:
+    """This factor's check, the faceted draw's, and the table of every factor's draw beside it."""
+    row, p, passed = _summary(data)
+    more = [f for f in MORE if ctx is not None and ctx.exists(f)]
+    others = [ctx.load(f) for f in more]
+    out = [_check(f"a slab {fx(data['switch']['value'], 2)} times as strong breaks where the observer saw SF rather "
+                  "than END", row, p, passed)]
+    if FACETED in more:
+        fac = others[more.index(FACETED)]
+        out += [_check(f"faceted slab layers at {fx(fac['switch']['value'], 2)} of the law's strength (in situ, "
+                       "Jamieson and Johnston 1990) break where the observer saw SF rather than END", *_summary(fac))]
+    out += [""] + table(["strength over the law's", "cases a class", "END records predicted SF",
+                         "SF records predicted SF", "ARR records predicted SF", "balanced accuracy",
+                         "p, SF against END"], [row] + [_summary(d)[0] for d in others])
+    out += ["", "Each count is of the records that ran, with the count at the law's strength in brackets."
+            + (" The other rows: the same command with `--scale`, `--faceted`, `--per-class` and `--out` ("
+               + ", ".join(ctx.link(f) for f in more) + ")." if more else ""), ""]
+    return out + (_faceted_lines(others[more.index(FACETED)]) if FACETED in more else [])
+
+
+def _cuts(data: dict) -> list[str]:
+    """The runaway cut's change where both ran away."""
+    cases = ran(data["cases"])
+    cuts = [c["after"]["runaway_cut"] / c["before"]["runaway_cut"] - 1.0 for c in cases
+            if c["before"].get("runaway_cut") and c["after"].get("runaway_cut")]
+    return [f"- The runaway cut, where both ran away ({len(cuts)} cases): {spct(min(cuts))} to {spct(max(cuts))} "
+            f"(median {spct(median(cuts))}).", ""] if cuts else []
+
+
+def _intro(data: dict) -> str:
+    s = fx(data["switch"]["value"], 2)
+    return (f"Cases: {data['chosen']}, each set up again from its pit as the batch set it up (the same key: the same "
+            f"parameters, the same protocol), every slab layer's tensile strength then set to {s} times its "
+            "density law's (Sigrist 2006, docs/model.md §9) and nothing else changed: the fracture energy stays the "
+            f"density law's. Each pair of values is at the law's strength (the batch's run) / at {s} of it.")
 
 
 @section("field", "The slab's strength: the same columns with a weaker slab", MAIN,
-         lambda d: f"python benchmarks/field/strength.py DIR --runs RUNDIR --scale {d['scale']:g} "
-                   f"--per-class {d['per_class']} --seed {d['seed']} --max-wall {d['max_wall_s']:g} "
-                   f"--workers {d['workers']} --threads {d['threads']} --out benchmarks/{os.path.dirname(MAIN)}",
+         command("strength", lambda d: f" --scale {d['switch']['value']:g} --out benchmarks/{os.path.dirname(MAIN)}"),
          question="Is the slab's tensile strength the lever that would tell SF from END? The same columns, every slab "
                   "layer's strength scaled by a what-if factor (not a calibration: no default changes).",
          follows="The laminate closure: the slab's stress at the weak layer against the FE", page="field_slab")
 def render_strength(data: dict, ctx) -> list[str]:
-    s = data["scale"]
-    cases = data["cases"]
-    rows = []
-    for c in cases:
-        a, b = c["law"], c["scaled"]
-        rows.append([f"`{c['test']}`", c["observed"], f"{a['predicted']} / {b['predicted'] or b.get('status')}",
-                     f"{_cut(a['runaway_cut'])} / {_cut(b['runaway_cut'])}", _cut(b["slab_fracture_at"]),
-                     f"{count(a['steps'])} / {count(b['steps'])}",
-                     f"{fx(a['wall_s'], 0)} ({a.get('threads') or '-'}) / "
-                     f"{fx(b['wall_s'], 0)} ({b.get('threads') or '-'})"])
-    out = [f"Cases: {data['chosen']}, each set up again from its pit as the batch set it up (the same key: the same "
-           f"parameters, the same protocol), every slab layer's tensile strength then set to {fx(s, 2)} times its "
-           "density law's (Sigrist 2006, docs/model.md §9) and nothing else changed: the fracture energy stays the "
-           f"density law's. Each pair of values is at the law's strength (the batch's run) / at {fx(s, 2)} of it.", ""]
-    out += table(["record", "observed", "predicted", "runaway cut (m)", "slab broke at (m), weaker",
-                  "steps", "wall time, s (threads)"], rows)
-    ran = [c for c in cases if c["scaled"].get("status") == "ok"]
-    row, p, passed = _summary(data)
-    more = [f for f in MORE if ctx is not None and ctx.exists(f)]
-    others = [ctx.load(f) for f in more]
-    out += ["", _check(f"a slab {fx(s, 2)} times as strong breaks where the observer saw SF rather than END", row, p,
-                       passed)]
-    if FACETED in more:
-        fac = others[more.index(FACETED)]
-        frow, *rest = _summary(fac)
-        out += [_check(f"faceted slab layers at {fx(fac['faceted'], 2)} of the law's strength (in situ, Jamieson and "
-                       "Johnston 1990) break where the observer saw SF rather than END", frow, *rest)]
-    out += [""]
-    summary = [row] + [_summary(d)[0] for d in others]
-    out += table(["strength over the law's", "cases a class", "END records predicted SF", "SF records predicted SF",
-                  "ARR records predicted SF", "balanced accuracy", "p, SF against END"], summary)
-    out += ["", "Each count is of the records that ran, with the count at the law's strength in brackets."
-            + (" The other rows: the same command with `--scale`, `--faceted`, `--per-class` and `--out` ("
-               + ", ".join(ctx.link(f) for f in more) + ")." if more else ""), ""]
-    if FACETED in more:
-        out += _faceted_lines(others[more.index(FACETED)])
-    parts = []
-    for side, name in (("law", "at the law's strength"), ("scaled", f"at {fx(s, 2)} of it")):
-        ba, rec = _balanced(ran, side)
-        parts.append(f"{name} {fx(ba, 2)} (recall " + ", ".join(f"{k} {fx(v, 2)}" for k, v in rec.items()) + ")")
-    out += [f"- On these {len(ran)} cases (drawn by observed class, not a score of the development set): the "
-            f"balanced accuracy {parts[0]}; {parts[1]}.", ""]
-    failed = [c for c in cases if c["scaled"].get("status") != "ok"]
-    if failed:
-        out += ["- Failed with the weaker slab: " + "; ".join(
-            f"`{c['test']}`: {(c['scaled'].get('error') or '').split(': ', 1)[-1].split(';')[0]}"
-            for c in failed) + ".", ""]
-    cuts = [c["scaled"]["runaway_cut"] / c["law"]["runaway_cut"] - 1.0 for c in ran
-            if c["law"].get("runaway_cut") and c["scaled"].get("runaway_cut")]
-    if cuts:
-        out += [f"- The runaway cut, where both ran away ({len(cuts)} cases): {spct(min(cuts))} to {spct(max(cuts))} "
-                f"(median {spct(median(cuts))}).", ""]
-    out += [env_note(data)]
-    return out
+    return render_what_if(data, ctx, intro=_intro, checks=(), notes=(_factors, balanced_line, failed_lines, _cuts),
+                          columns=("predicted", "runaway", ("slab broke at (m), weaker", COLUMNS["broke_after"][1]),
+                                   "steps", "wall_threads"))
 
 
 def _static_row(cases: list, cls: str) -> list:
@@ -172,7 +163,7 @@ def _static_row(cases: list, cls: str) -> list:
 
 def _static_balanced(cases: list, key: str) -> tuple[float, dict]:
     """weac's static rule's balanced accuracy under ``key`` (its classes are SF and END) and its recalls."""
-    return _balanced([{"observed": c["observed"], "x": {"predicted": c[key]}} for c in cases], "x")
+    return balanced([{"observed": c["observed"], "x": {"predicted": c[key]}} for c in cases], "x")
 
 
 @section("field", "The slab's strength by grain form: weac's static rule on every scored column",
