@@ -307,8 +307,8 @@ def test_driver_rejects_bad_paths(F):
 
 @pytest.mark.parametrize("dtype", ["float32", "float64"])
 def test_p0_series_and_library_sinh(dtype):
-    """p0 = K sinh(xi |log_jp|): the Taylor series below x = 1/4 and the library above, within 2 rounding units of
-    sinh (measured 1.9 u in both precisions), the cap at asinh(41.4) and the floor."""
+    """p0 = K sinh(xi |log_jp|): the Taylor series below x = 1/4 within 2 rounding units of sinh (measured 1.9 u in both
+    precisions), the library above within its own bound, the cap at asinh(41.4) and the floor."""
     T, nt = {"float32": (wp.float32, np.float32), "float64": (wp.float64, np.float64)}[dtype]
     u = 2.0**-24 if dtype == "float32" else 2.0**-53
     p0f = camclay_p0_func(T)
@@ -325,4 +325,10 @@ def test_p0_series_and_library_sinh(dtype):
     got = out.numpy().astype(np.longdouble)
     x_cap = np.arcsinh(-3.0 * np.log(SINGULAR_VALUE_FLOOR))
     ref = np.maximum(np.sinh(np.minimum(x.astype(np.longdouble), x_cap)), 1e-30)
-    assert float(np.max(np.abs(got - ref) / ref)) <= 2.0 * u
+    err = np.abs(got - ref) / ref
+    series = x <= 0.25
+    assert float(np.max(err[series])) <= 2.0 * u                   # our Taylor series: 2 u on every device
+    # the library's sinh: 2 u measured on the CPU's; on CUDA its documented bound, 3 ulp for sinhf and 2 ulp for
+    # sinh (CUDA C++ Programming Guide, "Mathematical Functions"), one ulp being 2 u
+    library = 2.0 * (3.0 if dtype == "float32" else 2.0) * u if DEVICE.startswith("cuda") else 2.0 * u
+    assert float(np.max(err[~series])) <= library

@@ -195,7 +195,7 @@ def test_device_resolution_with_and_without_cuda(monkeypatch):
 
 
 def test_sweep_one_worker_per_gpu(monkeypatch):
-    import distributed
+    distributed = pytest.importorskip("distributed", reason="the sweep's Dask (distributed) is not installed")
 
     monkeypatch.delenv("MPM_WARP_DEVICE", raising=False)
     monkeypatch.setattr(sweep, "_n_gpus", lambda: 3)
