@@ -95,6 +95,8 @@ class Case:
     overrides: tuple = ()
     model: str = ""
     dim: int = 3
+    #: run this many copies of the scene stepped together (mpm_warp.column_batch: the shared step's kernels)
+    columns: int = 0
 
 
 def _cases() -> tuple[Case, ...]:
@@ -108,6 +110,8 @@ def _cases() -> tuple[Case, ...]:
         for model in DRIVER_MODELS:
             for dim in (2, 3):
                 out.append(Case(f"material_point/{model}/{dim}d/{prec}", prec, model=model, dim=dim))
+        out.append(Case(f"columns/elastic_block/2d/{prec}", prec, scene="elastic_block", columns=2,
+                        overrides=tuple(_GEOMETRIES["elastic_block"]["2d"]) + (f"precision='{prec}'",)))
     return tuple(out)
 
 
@@ -179,12 +183,26 @@ def run_cases(out_dir: str, cases=CASES) -> dict[str, dict]:
             if case.model:
                 _drive(case)
                 info = {"particles": 3, "steps": 3}
+            elif case.columns:
+                info = _together(case, os.path.join(out_dir, f"case{i}"))
             else:
                 res = mw.run(case.scene, os.path.join(out_dir, f"case{i}.h5"), device="cpu",
                              overrides=list(case.overrides))
                 info = {"particles": res.n_particles, "steps": res.steps}
         runs[case.name] = {"modules": mods, **info}
     return runs
+
+
+def _together(case: Case, prefix: str) -> dict:
+    """``case.columns`` copies of the case's scene stepped together on the CPU (:mod:`mpm_warp.column_batch`),
+    writing ``<prefix>_<k>.h5``."""
+    import mpm_warp as mw
+    from mpm_warp.column_batch import run_columns
+    from mpm_warp.runner import simulation_for
+
+    sims = [simulation_for(mw.load_scenario(case.scene, list(case.overrides)), "cpu", 1) for _ in range(case.columns)]
+    res = run_columns(sims, [f"{prefix}_{k}.h5" for k in range(case.columns)])
+    return {"particles": sum(r.n_particles for r in res), "steps": res[0].steps}
 
 
 @dataclass

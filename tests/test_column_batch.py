@@ -38,7 +38,8 @@ def _field_scenarios(tmp_path):
 
 def _outcome(res):
     o = res.scene_result.get("outcome", {})
-    return o.get("class"), res.scene_result.get("runaway_cut"), res.steps, res.sim_time
+    return (o.get("class"), res.scene_result.get("runaway_cut"), res.scene_result.get("damage_speed_mean"), res.steps,
+            res.sim_time)
 
 
 @pytest.mark.slow
@@ -65,16 +66,18 @@ def test_four_field_columns_stepped_together_match_their_runs_alone_at_one_step(
     together = run_columns(sims, [str(tmp_path / f"together{k}.h5") for k in range(4)], until_decided)
     classes = [o[0][0] for o in alone]
     assert classes == ["END", "NP", "NP", "END"]                      # two outcomes, decided at four times
-    assert len({o[0][3] for o in alone}) == 4
+    assert len({o[0][4] for o in alone}) == 4
     for k, (res, sim) in enumerate(zip(together, sims, strict=True)):
-        assert _outcome(res)[:3] == alone[k][0][:3]                      # class, runaway cut, steps: the same
-        assert res.sim_time == pytest.approx(alone[k][0][3], abs=1e-12)
+        # class, runaway cut, front speed and steps: the same (NaN where a run has none)
+        np.testing.assert_equal(_outcome(res)[:4], alone[k][0][:4])
+        assert res.sim_time == pytest.approx(alone[k][0][4], abs=1e-12)
         # a decided column stopped where its run alone stopped: not one step further, bit for bit the same state
         np.testing.assert_array_equal(sim.state.x.numpy(), alone[k][1])
         assert frames_seen[k] == list(range(1, len(frames_seen[k]) + 1))
         assert mw.read_run(res.output).n_frames == len(frames_seen[k]) + 1
-    # the END columns' cracks ran away at the cuts of their runs alone (finite, inside the column)
+    # the END columns' cracks ran away at the cuts of their runs alone (finite, inside the column), at a speed
     assert all(0.0 < together[k].scene_result["runaway_cut"] < scenarios[k].scene.length for k in (0, 3))
+    assert all(together[k].scene_result["damage_speed_mean"] > 1.0 for k in (0, 3))
 
 
 def _block(tmp_path, speed: float, threads: int = 1):

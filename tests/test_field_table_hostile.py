@@ -70,6 +70,7 @@ CASES = [
      ["refused t.csv#p1: row 2: layers file slab.csv: is UTF-16 or binary"], []),
     ("scheduler-not-an-address", {"t.csv": table()}, ["--scheduler", "notanaddress"], 2,
      ["scheduler = 'notanaddress' is invalid", "tcp://host:8786", "missing port number"], []),
+    ("device-not-here", {"t.csv": table()}, ["--device", "cuda:7"], 2, ["device = 'cuda:7' is invalid"], []),
     ("negative-layer", layered("thickness_cm,density\n-5,200\n"), [], 0,
      ["refused t.csv#p1: row 2: slab.csv row 2: thickness_cm = -5 cm is outside the range",
       "expected a thickness in (0, 500] cm"], []),

@@ -249,7 +249,7 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
     """
     if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
         raise InvalidArgument("limit", limit, "an integer >= 1")
-    proto = _checked(workers, scheduler, protocol, out_dir)
+    proto = _checked(workers, scheduler, protocol, out_dir, device)
     items, refused, shown = iter_gather(inputs), [], Progress(_stream(progress))
 
     def setup():
@@ -272,12 +272,18 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
     return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose)
 
 
-def _checked(workers, scheduler, protocol, out_dir) -> FieldProtocol:
-    """The batch's protocol, once its arguments and its folder are checked (before anything is set up)."""
+def _checked(workers, scheduler, protocol, out_dir, device=None) -> FieldProtocol:
+    """The batch's protocol, once its arguments, its device (here, unless the cases go to a running scheduler,
+    whose workers may have devices this machine has not) and its folder are checked (before anything is set
+    up)."""
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise InvalidArgument("workers", workers, "an integer >= 1")
     proto = (protocol or FieldProtocol()).validate()
     check_scheduler(scheduler)
+    if scheduler is None and device is not None:
+        from ..device import resolve_device
+
+        resolve_device(device)
     check_out_dir(out_dir)
     return proto
 
@@ -291,7 +297,7 @@ def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None =
               verbose: bool = False) -> FieldBatch:
     """Run the field cases ``cases`` (:func:`gather`'s, or a selection of them) and score them, as :func:`run_field`;
     ``refused`` (their refusals) goes to ``refused.csv``."""
-    proto = _checked(workers, scheduler, protocol, out_dir)
+    proto = _checked(workers, scheduler, protocol, out_dir, device)
     refused, shown = list(refused), Progress(_stream(progress))
 
     def setup():

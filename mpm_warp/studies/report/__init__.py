@@ -38,6 +38,7 @@ from . import (  # noqa: F401
     convergence,
     field,
     field_closure,
+    field_columns,
     field_far_end,
     field_forecast,
     field_plane_stress,
