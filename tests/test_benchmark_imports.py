@@ -2,8 +2,8 @@
 
 Each ``benchmarks/**/*.py`` is parsed with ``ast``; an import whose top-level name is the stem of a file under
 ``benchmarks/`` (``from closure import draw``), an import of ``benchmarks`` itself, or a way around the import
-statement (``sys.path``, ``importlib``, ``runpy``, ``__import__``, ``spec_from_file_location``) fails it, beyond
-the few of ``benchmarks/perf/`` listed in :data:`KNOWN` (a list that may only shrink).
+statement (``sys.path``, ``importlib``, ``runpy``, ``__import__``, ``spec_from_file_location``) fails it, with no
+exception (the block benchmarks' shared code and Taichi peer are ``mpm_warp.studies.perf``).
 """
 
 from __future__ import annotations
@@ -15,18 +15,6 @@ import os
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-#: the imports between scripts that remain, all in ``benchmarks/perf/`` (outside the field studies' clean-up): the
-#: Taichi peer (taichi is no dependency of the package, so its block stays beside the scripts) and the block
-#: protocol its scripts share (benchmarks/README.md, "Helpers"). The list may only shrink: an entry that no longer
-#: stands fails the test too.
-KNOWN = {
-    "perf/device_suite.py": ["imports throughput"],
-    "perf/plastic_step.py": ["imports warp_block", "imports return_cost", "imports taichi_peer"],
-    "perf/taichi_mpm.py": ["imports taichi_camclay"],
-    "perf/taichi_peer.py": ["imports importlib.util", "imports taichi_mpm", "importlib"],
-    "perf/throughput.py": ["imports warp_block", "imports taichi_peer"],
-}
 
 #: names that load code from a path or a string instead of an import statement
 _AROUND = {"path", "importlib", "runpy", "__import__", "spec_from_file_location", "import_module", "run_path"}
@@ -68,9 +56,8 @@ def script_imports(root: str) -> dict[str, list[str]]:
 def test_no_benchmark_script_imports_another():
     found = script_imports(ROOT)
     assert len(found) >= 44, "the benchmark scripts were not found"
-    bad = {rel: lines for rel, lines in found.items() if [ln.split(": ", 1)[1] for ln in lines] != KNOWN.get(rel, [])}
+    bad = {rel: lines for rel, lines in found.items() if lines}
     assert not bad, f"scripts that import scripts (move what they share into the package): {bad}"
-    assert not [rel for rel in found if rel.startswith("field/") and found[rel]]
 
 
 @pytest.mark.parametrize("source, what", [

@@ -245,7 +245,7 @@ def part_field(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
 
 def part_throughput(device: str, quick: bool, deadline: float, out_dir: str) -> dict:
     """``throughput.run`` at 1M and 4M (quick: one tiny size), 2D and 3D, elastic and plastic, beside Taichi."""
-    import throughput
+    from mpm_warp.studies.perf import throughput
 
     name = f"device_suite_throughput_{_tag(device, quick)}"
     particles = list(QUICK_PARTICLES if quick else FULL_PARTICLES)

@@ -5,7 +5,7 @@ Usage: ``python benchmarks/perf/plastic_step.py [--n-grid 32 48 64] [--n-grid-2d
 Writes ``benchmarks/perf/results/plastic_step_<device>.json``.
 
 For every size both engines run the same scene with the same protocol
-(``warp_block`` / ``taichi_peer``: compiled, warmed up to yield, median of
+(``mpm_warp.studies.perf``: ``warp_block`` / ``taichi_peer``; compiled, warmed up to yield, median of
 ``--repeats`` repeats of ``--steps`` steps from one snapshot; Taichi in its own
 process). Each row records:
 
@@ -18,7 +18,7 @@ process). Each row records:
 * where the time goes: mpm_warp per stage (one thread), its step with
   plasticity compiled out (an elastic material of the same E, nu, rho on the
   same state), and its constitutive update and the update's parts alone on
-  the step's trial states (``return_cost``: small-strain check, principal
+  the step's trial states (``update_cost``, as ``return_cost.py``: small-strain check, principal
   strains, return, and a decomposition-free prototype checked against the
   engine); Taichi's step with the return compiled out (SVD kept).
 """
@@ -29,13 +29,12 @@ import os
 import statistics
 import sys
 
-import warp_block
-from return_cost import update_cost
-from taichi_peer import run_taichi_block_subprocess
-
 from mpm_warp.studies import plastic_block as pb
 from mpm_warp.studies.blocks import block_simulation
 from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.perf.taichi_peer import run_taichi_block_subprocess
+from mpm_warp.studies.perf.update_cost import update_cost
+from mpm_warp.studies.perf.warp_block import run_block
 from mpm_warp.studies.protocol import out_dir, parser, result_name
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
@@ -43,8 +42,8 @@ RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 
 def compare_size(dim: int, n_grid: int, steps: int, threads: int, device: str, repeats: int, taichi: bool) -> dict:
     """One size: mpm_warp and Taichi rows, ratio, agreement and where the time goes."""
-    w = warp_block.run_block(dim, "plastic", n_grid, steps, device=device, n_threads=threads, repeats=repeats,
-                             stages=True, diagnostics=True, return_share=True)
+    w = run_block(dim, "plastic", n_grid, steps, device=device, n_threads=threads, repeats=repeats,
+                  stages=True, diagnostics=True, return_share=True)
     sim = block_simulation(dim, "plastic", n_grid, device, n_threads=1)
     sim.stepper.set_frame_end(1e9)
     sim.stepper.steps(w["warmup"])

@@ -10,7 +10,7 @@ Usage::
 ``n_grid**dim`` closest to it (2 particles per cell and axis in a unit box).
 The elastic block is ``mpm_warp.studies.blocks.block_scenario`` (E = 1e5 Pa, rho = 1000, dt =
 1e-4 s, or dx / c_p on grids finer than 1.16 mm; free fall); the plastic block is the struck Cam-Clay snow of
-``mpm_warp.studies.plastic_block``. Both engines follow the protocol of ``warp_block`` /
+``mpm_warp.studies.plastic_block``. Both engines follow the protocol of ``mpm_warp.studies.perf.warp_block`` /
 ``taichi_peer`` (compiled, warmed up, median of three repeats from one
 snapshot; Taichi in its own process per configuration). On the CPU each row
 also has ``cpu_utilisation`` and ``particle_steps_per_cpu_s`` (per second of
@@ -25,90 +25,15 @@ from __future__ import annotations
 
 import os
 import sys
-import time
-
-import warp_block
-from taichi_peer import run_taichi_block_subprocess
 
 from mpm_warp.finite_json import load_json
-from mpm_warp.studies import plastic_block as pb
-from mpm_warp.studies.environment import environment, write_json
+from mpm_warp.studies.environment import environment
 from mpm_warp.studies.figures import pyplot, save_figure
+from mpm_warp.studies.perf.throughput import run
 from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 DEFAULT_PARTICLES = [13824, 32768, 110592, 262144]
-
-
-#: Smallest elastic grid: the block [0.25, 0.75] must lie inside the slip walls three cells in from the box edge.
-MIN_N_GRID_ELASTIC = 16
-
-
-def n_grid_for(particles: float, dim: int, material: str = "elastic") -> int:
-    """Even cells per axis with ``n_grid**dim`` closest to ``particles``, at least the scene's minimum."""
-    n = 2 * round(float(particles) ** (1.0 / dim) / 2.0)
-    return max(n, pb.MIN_N_GRID if material == "plastic" else MIN_N_GRID_ELASTIC)
-
-
-def measure(dim: int, material: str, n_grid: int, steps: int, device: str, threads: int | None,
-            taichi: bool, repeats: int = 3, taichi_timeout_s: float = 600.0) -> list[dict]:
-    """Rows of one configuration: mpm_warp, Taichi (or why it is missing), and the ratio."""
-    cuda = device.startswith("cuda")
-    w = warp_block.run_block(dim, material, n_grid, steps, device=device, n_threads=threads, repeats=repeats,
-                             stages=(threads == 1 and not cuda), diagnostics=(material == "plastic"))
-    print(f"mpm_warp {dim}D {material:7s} N {w['n_particles']:9d} threads {w['threads']}: "
-          f"{w['particle_steps_per_s'] / 1e6:8.2f} M particle-steps/s", flush=True)
-    rows = [w]
-    if not taichi:
-        return rows
-    arch = "cuda" if cuda else "cpu"
-    res, err = run_taichi_block_subprocess(n_grid, steps, arch=arch, cpu_max_num_threads=None if cuda else threads,
-                                           repeats=repeats, dim=dim, material=material, warmup=w.get("warmup"),
-                                           diagnostics=(material == "plastic"), timeout_s=taichi_timeout_s)
-    if res is None:
-        rows.append({"engine": "taichi", "dim": dim, "material": material, "n_grid": n_grid, "threads": threads,
-                     "error": err})
-        print(f"taichi   {dim}D {material:7s} N {n_grid**dim:9d}: unavailable ({err})", flush=True)
-        return rows
-    rows.append(res)
-    w["taichi_particle_steps_per_s"] = res["particle_steps_per_s"]
-    w["ratio_vs_taichi"] = w["particle_steps_per_s"] / res["particle_steps_per_s"]
-    if not cuda:  # on a shared CPU: particle-steps per second of process CPU time, robust to other users' load
-        for r in (w, res):
-            r["particle_steps_per_cpu_s"] = r["particle_steps_per_s"] / r["cpu_utilisation"]
-        w["ratio_vs_taichi_cpu_time"] = w["particle_steps_per_cpu_s"] / res["particle_steps_per_cpu_s"]
-    msg = f"  -> mpm_warp/taichi {w['ratio_vs_taichi']:.2f}"
-    if material == "plastic" and "observables" in res:
-        w["agreement_with_taichi"] = pb.agreement(w["observables"], res["observables"])
-        msg += f"; observables agree: {w['agreement_with_taichi']['agree']}"
-    print(f"taichi   {dim}D {material:7s} N {res['n_particles']:9d} threads {res['threads']}: "
-          f"{res['particle_steps_per_s'] / 1e6:8.2f} M particle-steps/s{msg}", flush=True)
-    return rows
-
-
-def run(dims, materials, particles, steps: int, device: str, threads_list, taichi: bool, name: str,
-        repeats: int = 3, results_dir: str = RESULTS, taichi_timeout_s: float = 600.0,
-        size_major: bool = False) -> dict:
-    """Measure every configuration, rewriting the JSON after each; return the result dict.
-
-    Configurations run dimension by dimension, material by material, size by
-    size; ``size_major`` puts the size loop outermost instead (all small runs
-    first, as a time-boxed run wants). ``seconds`` holds the time of each.
-    """
-    out = {"benchmark": "MLS-MPM block throughput beside Taichi (float32; elastic: Hencky StVK block in free fall, "
-                        "plastic: struck Cam-Clay snow block of mpm_warp.studies.plastic_block)",
-           "environment": environment(device), "steps": steps, "repeats": repeats, "rows": [], "seconds": {}}
-    configs = [(dim, material, N) for dim in dims for material in materials for N in particles]
-    if size_major:
-        configs.sort(key=lambda c: particles.index(c[2]))  # stable: dims and materials keep their order
-    for dim, material, N in configs:
-        n = n_grid_for(N, dim, material)
-        for nt in threads_list:
-            t0 = time.perf_counter()
-            out["rows"] += measure(dim, material, n, steps, device, nt, taichi, repeats, taichi_timeout_s)
-            out["seconds"][f"{dim}d_{material}_{n}_{nt}"] = time.perf_counter() - t0
-            write_json(name, out, results_dir)
-    return out
 
 
 def figure(out: dict, path: str) -> None:
@@ -166,7 +91,7 @@ def main(argv=None) -> int:
     name = a.name or f"throughput_{'cuda' if cuda else 'cpu'}" + ("_quick" if a.quick else "")
     folder = out_dir(a, RESULTS, "throughput")
     out = run(a.dims, a.materials, a.particles, a.steps, a.device, threads, not a.no_taichi, name, a.repeats,
-              results_dir=folder)
+              results_dir=folder, env=environment(a.device))
     figure(out, os.path.join(folder, name + ".png"))
     print("wrote", os.path.join(folder, name + ".json"))
     return 0

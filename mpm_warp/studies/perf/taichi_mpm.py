@@ -4,7 +4,7 @@ Written the way an experienced Taichi user would write it (mpm88/mpm128 style):
 one fused ``ti.kernel`` per step whose top-level loops are parallel,
 ``ti.static`` stencil loops, ``ti.svd`` for the polar/singular values, dense
 fields, scene constants folded in as Python floats. Taichi is imported by the
-caller (``taichi_peer.py``) and passed in; this module never imports it.
+caller (:mod:`.taichi_peer`) and passed in; this module never imports it.
 
 Constitutive update per particle (docs/model.md §1 and 4)
 ---------------------------------------------------
@@ -17,7 +17,7 @@ particles since the total ``F_zz`` is 1): the return sees the three principal
 stretches ``(s_0, s_1, F_zz)`` and the in-plane stress uses ``tr eps`` over all
 three.
 
-The Cam-Clay return (``taichi_camclay``) is the same algorithm as mpm_warp's (docs/model.md §4).
+The Cam-Clay return (:mod:`.taichi_camclay`) is the same algorithm as mpm_warp's (docs/model.md §4).
 """
 
 from __future__ import annotations
@@ -26,10 +26,10 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
-from taichi_camclay import S_FLOOR, camclay_return_func
 
-from mpm_warp.studies import plastic_block as pb
-from mpm_warp.studies.blocks import ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, GRAVITY_Y, elastic_time_step
+from .. import plastic_block as pb
+from ..blocks import ELASTIC_E, ELASTIC_NU, ELASTIC_RHO, GRAVITY_Y, elastic_time_step
+from .taichi_camclay import S_FLOOR, camclay_return_func
 
 #: Width (in cells) of the slip boundary layer, Taichi style.
 BOUND = 3

@@ -1,21 +1,21 @@
-"""Taichi peer of the block benchmarks: run ``taichi_mpm`` with the protocol of ``warp_block``.
+"""Taichi peer of the block benchmarks: run :mod:`.taichi_mpm` with the protocol of :mod:`.warp_block`.
 
 The scene (2D plane strain or 3D, elastic or Cam-Clay) is defined in
-``taichi_mpm.py`` and :mod:`mpm_warp.studies.blocks`; this module runs it: ``ti.init``,
+:mod:`.taichi_mpm` and :mod:`mpm_warp.studies.blocks`; this module runs it: ``ti.init``,
 compile, ``warmup`` untimed steps, snapshot, then ``repeats`` repeats that
 each restore the snapshot and time ``steps`` steps; the median is reported.
 On the CPU the faster of the atomic and serialized P2G scatters is picked by a
 few untimed probe steps, as a tuned Taichi code would.
 
 Taichi is an optional extra (``pip install mpm-warp[bench]``): it is imported
-lazily, only here, never by the library. Taichi keeps one runtime per process
+lazily, only inside :func:`run_taichi_block`, never by the library. Taichi keeps one runtime per process
 and sizes its CPU thread pool at ``ti.init``, so every configuration runs in
 its own interpreter (:func:`run_taichi_block_subprocess`).
 
 Command line
 ------------
-``python benchmarks/perf/taichi_peer.py --n-grid 32 --dim 3 --material plastic --steps 50 --arch cpu --threads 1
---json``
+``python -m mpm_warp.studies.perf.taichi_peer --n-grid 32 --dim 3 --material plastic --steps 50 --arch cpu
+--threads 1 --json``
 prints the result dict of :func:`run_taichi_block` as one JSON line on stdout
 (Taichi's own log lines go to stderr).
 """
@@ -35,12 +35,15 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-import taichi_mpm
-
-from mpm_warp.studies import plastic_block as pb
-from mpm_warp.studies.blocks import default_warmup, expected_com_y, initial_state
+from .. import plastic_block as pb
+from ..blocks import default_warmup, expected_com_y, initial_state
+from . import taichi_mpm
 
 _ARCH_NAMES = ("cpu", "cuda", "gpu", "vulkan", "metal", "opengl")
+#: the module a child interpreter runs (``python -m``)
+MODULE = "mpm_warp.studies.perf.taichi_peer"
+#: the folder that holds this ``mpm_warp`` package: a child of the same interpreter imports this copy
+_PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 
 
 def taichi_available() -> bool:
@@ -202,15 +205,27 @@ def run_taichi_block_subprocess(n_grid: int, steps: int, arch: str = "cpu", cpu_
                                 timeout_s: float | None = 600.0, dim: int = 3, material: str = "elastic",
                                 warmup: int | None = None, diagnostics: bool = False,
                                 return_share: bool = False) -> tuple[dict | None, str | None]:
-    """Run :func:`run_taichi_block` in a fresh interpreter and parse its JSON line.
+    """Run :func:`run_taichi_block` in a fresh interpreter (``python -m``, :data:`MODULE`) and parse its JSON line.
 
-    Returns ``(result, None)`` on success and ``(None, reason)`` when Taichi is
-    not installed for ``python``, the run failed or it ran past ``timeout_s``.
+    Parameters
+    ----------
+    n_grid, steps, arch, cpu_max_num_threads, repeats, p2g_scatter, dim, material, warmup, diagnostics, return_share
+        As :func:`run_taichi_block`.
+    python : str or None
+        The interpreter (default this one, which then imports the same ``mpm_warp`` as this process).
+    timeout_s : float or None
+        Wall-clock limit of the child, seconds (None: none).
+
+    Returns
+    -------
+    tuple
+        ``(result, None)`` on success and ``(None, reason)`` when Taichi is
+        not installed for ``python``, the run failed or it ran past ``timeout_s``.
     """
     python = python or sys.executable
     if python == sys.executable and not taichi_available():
         return None, "taichi is not installed (pip install 'mpm-warp[bench]' or 'pip install taichi')"
-    cmd = [python, os.path.abspath(__file__), "--n-grid", str(n_grid), "--steps", str(steps), "--arch", arch,
+    cmd = [python, "-m", MODULE, "--n-grid", str(n_grid), "--steps", str(steps), "--arch", arch,
            "--repeats", str(repeats), "--p2g-scatter", p2g_scatter, "--dim", str(dim), "--material", material,
            "--json"]
     if cpu_max_num_threads is not None:
@@ -221,8 +236,11 @@ def run_taichi_block_subprocess(n_grid: int, steps: int, arch: str = "cpu", cpu_
         cmd.append("--diagnostics")
     if return_share:
         cmd.append("--return-share")
+    env = None
+    if python == sys.executable:
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [_PACKAGE_ROOT, os.environ.get("PYTHONPATH")])))
     try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s, check=False)
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s, check=False, env=env)
     except subprocess.TimeoutExpired:
         return None, f"taichi peer timed out after {timeout_s} s"
     except OSError as exc:

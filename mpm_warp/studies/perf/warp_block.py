@@ -1,6 +1,6 @@
 """The mpm_warp side of the block benchmarks: build, warm up, snapshot, time, diagnose.
 
-Both engines follow one protocol (``taichi_peer.run_taichi_block`` is the
+Both engines follow one protocol (:func:`.taichi_peer.run_taichi_block` is the
 Taichi side): build the scene and compile its kernels; step ``warmup`` steps
 untimed; take a snapshot of the state; for each of ``repeats`` repeats restore
 the snapshot and time ``steps`` steps (device synchronised before and after);
@@ -9,7 +9,7 @@ repeat, i.e. after ``warmup + steps`` steps from the start. Cam-Clay runs also
 record, for every timed step (replayed from the snapshot with the ``yielded``
 output on), the fractions of particles whose return was active and of cap and
 dry-side returns (:func:`mpm_warp.studies.plastic_block.return_kinds`). The scenes are
-:mod:`mpm_warp.studies.blocks`.
+:mod:`mpm_warp.studies.blocks`; the scripts ``benchmarks/perf/throughput.py`` and ``plastic_step.py`` time them.
 """
 
 from __future__ import annotations
@@ -20,13 +20,13 @@ import time
 import numpy as np
 import warp as wp
 
-import mpm_warp
-from mpm_warp.studies import plastic_block as pb
-from mpm_warp.studies.blocks import block_simulation, default_warmup
-from mpm_warp.studies.timing import stage_times
+from ...simulation import Simulation
+from .. import plastic_block as pb
+from ..blocks import block_simulation, default_warmup
+from ..timing import stage_times
 
 
-def _timed(sim: mpm_warp.Simulation, snap: dict, steps: int, repeats: int) -> tuple[list[float], list[float]]:
+def _timed(sim: Simulation, snap: dict, steps: int, repeats: int) -> tuple[list[float], list[float]]:
     """Wall seconds and process CPU seconds per step of ``repeats`` batches of ``steps`` steps, each from the
     snapshot (CPU time below wall time times the thread count: the cores were shared)."""
     st = sim.stepper
@@ -45,7 +45,11 @@ def _timed(sim: mpm_warp.Simulation, snap: dict, steps: int, repeats: int) -> tu
 
 
 def return_kinds_per_step(dim: int, n_grid: int, snap: dict, steps: int, device: str, n_threads: int | None):
-    """Per-step ``plastic_block.return_kinds`` of ``steps`` steps replayed from ``snap`` with yield tracking."""
+    """Per-step ``plastic_block.return_kinds`` of ``steps`` steps replayed from ``snap`` with yield tracking.
+
+    ``snap`` holds the state's arrays (``State.arrays()``); ``n_threads`` as :func:`run_block`. Returns one dict a
+    step (fractions of the particles).
+    """
     sim = block_simulation(dim, "plastic", n_grid, device, n_threads, track_yield=True)
     sim.state.load_arrays(snap)
     st = sim.stepper
@@ -66,6 +70,25 @@ def run_block(dim: int, material: str, n_grid: int, steps: int, device: str = "c
               repeats: int = 3, warmup: int | None = None, stages: bool = False, diagnostics: bool = False,
               return_share: bool = False) -> dict:
     """Time the block in mpm_warp (protocol in the module docstring).
+
+    Parameters
+    ----------
+    dim : {2, 3}
+        2 is plane strain.
+    material : {"elastic", "plastic"}
+        The elastic block or the struck Cam-Clay block (:func:`mpm_warp.studies.blocks.block_simulation`).
+    n_grid : int
+        Cells per axis of the unit box; ``n_grid**dim`` particles.
+    steps, repeats : int
+        Timed steps per repeat and repeats, each from the snapshot (the median is reported).
+    device : str
+        Warp device.
+    n_threads : int or None
+        CPU threads (None: all).
+    warmup : int or None
+        Untimed steps before the snapshot (default :func:`mpm_warp.studies.blocks.default_warmup`).
+    stages, diagnostics, return_share : bool
+        What else to record (below).
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""The Cam-Clay return of the Taichi peer (``taichi_mpm``): ``ti.func``'s over one scene's constants.
+"""The Cam-Clay return of the Taichi peer (:mod:`.taichi_mpm`): ``ti.func``'s over one scene's constants.
 
 The Cam-Clay return is the same algorithm as mpm_warp's (docs/model.md §4): the
 point of the yield ellipse closest to the trial ``(p, q)`` in the energy metric
@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from mpm_warp.studies import plastic_block as pb
+from .. import plastic_block as pb
 
 #: Singular-value floor before ln (as mpm_warp's).
 S_FLOOR = 1.0e-6
