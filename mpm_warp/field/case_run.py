@@ -104,8 +104,11 @@ def run_case_group(tasks: list[dict]) -> list[dict]:
             _failed(recs[k], e)
     if sims:
         own = [column_step(tasks[k]["scenario"]) for k in members]
-        results = run_columns(sims, [outs[k] + ".part.h5" for k in members],
-                              lambda j, sim, frame: not decided(sim), overwrite=True)
+        try:
+            results = run_columns(sims, [outs[k] + ".part.h5" for k in members],
+                                  lambda j, sim, frame: not decided(sim), overwrite=True)
+        except Exception as e:     # the group could not start (a run file it may not write): each case says so
+            results = [e] * len(sims)
         for j, (k, res) in enumerate(zip(members, results, strict=True)):
             recs[k]["columns"], recs[k]["shared_step_cost"] = len(sims), own[j] / min(own)
             try:
