@@ -1,6 +1,7 @@
 """A PST's outcome as the field writes it: END / SF / ARR and the observer's line (mpm_warp.scenes.pst.outcome)."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -85,6 +86,7 @@ def test_the_slab_crack_detector_finds_a_through_crack_and_not_a_partial_one():
     kappa[band] = fail
     g.kappa.assign(kappa.astype(np.float32))
     assert math.isnan(det.through_crack())
+    assert det.crack_cover() == pytest.approx(10 / 24)    # rows 14-23 of 24: y above 60 % of the slab's height
     # through the whole slab, leaning by 3 cm from top to bottom: found at its median position
     lean = 0.42 + 0.03 * (x0[:, 1] - y_lo) / (y_hi - y_lo)
     band = np.abs(x0[:, 0] - lean) < 0.006
@@ -92,11 +94,49 @@ def test_the_slab_crack_detector_finds_a_through_crack_and_not_a_partial_one():
     kappa[band] = fail
     g.kappa.assign(kappa.astype(np.float32))
     assert det.through_crack() == pytest.approx(np.median(x0[band, 0]), abs=0.005)
+    assert det.crack_cover() == 1.0
     assert mon.units()["slab_crack"] == "m"
     # a slab that cannot break records no slab-crack series
     plain = pst.attach(mw.Simulation(mw.load_scenario("pst_demo", [o for o in SOFT_THIN if "fracture" not in o]),
                                      device="cpu"))
     assert plain.slab_crack is None and "slab_crack" not in plain.units()
+
+
+class _Host:
+    """A host array standing in for a device view (``.numpy()``)."""
+
+    def __init__(self, a):
+        self.a = np.asarray(a)
+
+    def numpy(self):
+        return self.a
+
+
+def test_the_slab_stress_ratio_is_the_stress_the_slab_carries():
+    """By hand, plane strain: E 5 MPa, nu 0.25 (mu = lam = 2 MPa), strength 5 kPa, G_f 0.2 J/m^2 over 1 cm: the
+    stress at full damage is 2 E G_f / (sigma_t h) = 40 kPa. A stretch e along a principal axis carries
+    tau_1 = (2 mu + lam) e = 6 MPa e and tau_2 = lam e."""
+    mat = mw.CrackingSnow(E=5e6, nu=0.25, density=200.0, tensile_strength=5e3, fracture_energy=0.2, band_width=0.01)
+    c, s = np.cos(0.6), np.sin(0.6)
+    R = np.array([[c, -s], [s, c]])
+
+    def ratio(*parts):
+        """``parts``: (principal Hencky strains (e1, e2), kappa Pa), each particle stretched in a rotated frame."""
+        H = np.array([R @ np.diag(np.exp(e)) @ R.T - np.eye(2) for e, _ in parts])
+        g = SimpleNamespace(material=mat, H=_Host(H), kappa=_Host([k for _, k in parts]))
+        return SlabCrackDetector.stress_ratio(SimpleNamespace(groups=[g]))
+
+    # intact: tau_1 = 6 MPa x 1e-4 = 600 Pa = 0.12 of the strength; a squeezed particle carries no tension
+    assert ratio(((1e-4, 0.0), 0.0)) == pytest.approx(0.12, rel=1e-6)
+    assert ratio(((-1e-3, -1e-3), 0.0), ((1e-4, 0.0), 0.0)) == pytest.approx(0.12, rel=1e-6)
+    # on its softening branch at kappa = tau_1 = 22.5 kPa (e = 3.75e-3), d = 1 - (5/22.5)(40 - 22.5)/35 = 8/9: it
+    # carries (1 - d) 22.5 kPa = 2.5 kPa, half its strength, and counts 1, having cracked (the unsoftened
+    # stress, 4.5 times the strength, is what the monitor read before)
+    e = 3.75e-3
+    assert mat.damage(22.5e3) == pytest.approx(8 / 9)
+    assert ratio(((e, 0.0), 22.5e3)) == 1.0
+    # an open crack stretched to e = 0.05: its unsoftened stress is 300 kPa, 60 times the strength; it carries none
+    assert ratio(((0.05, 0.0), 6e6 * 0.05), ((1e-4, 0.0), 0.0)) == 1.0
 
 
 @pytest.mark.slow

@@ -2,7 +2,7 @@
 
 Snow's tensile strength scatters from sample to sample as a Weibull law of modulus 1.5 (+- 0.5) with no size
 effect (Phys. Rev. E 69, 011306, 2004). The run's slab carried at most ``r`` times its density law's strength
-(``slab_peak_stress_ratio``, the largest over the frames; at least 1 where it cracked): a slab whose strength is
+(``slab_peak_stress_ratio``, the largest over the frames; 1 where it cracked): a slab whose strength is
 drawn below ``r`` times the law's breaks. Taking the law as the distribution's mean, ``P(SF) = 1 - exp(-(r
 Gamma(1 + 1/m))^m)`` with ``r`` capped at 1, since a crack that formed says the stress reached the strength and
 not how far beyond it a stronger slab would have been loaded. The rest goes to the run's own class (END for a

@@ -106,6 +106,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         if self.slab_crack is not None:
             u["slab_crack"] = "m"
             u["slab_stress_ratio"] = "-"
+            u["slab_crack_cover"] = "-"
         for k in range(len(self.markers)):
             u[f"marker{k}_ux"] = "m"
             u[f"marker{k}_uy"] = "m"
@@ -125,6 +126,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         if self.slab_crack is not None:
             out["slab_crack"] = self.slab_crack.through_crack()
             out["slab_stress_ratio"] = self.slab_crack.stress_ratio()
+            out["slab_crack_cover"] = self.slab_crack.crack_cover()
         c, sawn = self.weak.collapse()
         gone = (self.weak.bond() <= 0.0) & (sawn == 0) & self.interior
         out["collapse_height"] = float(np.mean(c[gone]) * p.weak_layer_thickness) if gone.any() else 0.0
@@ -195,6 +197,9 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         ratio = np.asarray(series.get("slab_stress_ratio", []), dtype=float)
         if ratio.size and np.isfinite(ratio).any():     # the slab's peak over its strength at the frames so far
             out["slab_peak_stress_ratio"] = float(np.nanmax(ratio))
+        cover = np.asarray(series.get("slab_crack_cover", []), dtype=float)
+        if cover.size and np.isfinite(cover).any():     # how far a crack went through the slab, at most
+            out["slab_peak_crack_cover"] = float(np.nanmax(cover))
         out.update(stop_record(self.params, self.stopped_at, runaway))
         return out
 

@@ -74,9 +74,16 @@ class SlabCrackDetector:
         return np.concatenate([g.material.damage(g.kappa.numpy()) for g in self.groups])
 
     def stress_ratio(self) -> float:
-        """The slab's largest tensile stress over its layer's strength now (-): the largest principal Kirchhoff
-        stress of the Hencky strain of ``F_E`` (the in-plane ones in 2D, where ``F_E,zz = 1``) over intact
-        particles, or the largest ``kappa`` (the effective stress a cracking particle reached) where larger."""
+        """The largest tensile stress the slab carries now over its layer's strength (-), 1 once a particle cracked.
+
+        The stress is the kernel's (``kernels/cracking.py``): the principal Kirchhoff stresses of the Hencky strain
+        of ``F_E`` (the in-plane ones in 2D, where ``F_E,zz = 1``), the tensile ones softened by ``1 - d(kappa)``.
+        A cracking material carries at most its strength, so the ratio is at most 1 (to the step's round-off); a
+        slab with a particle whose ``kappa`` passed the strength counts 1, its stress having reached the strength.
+        ``F_E`` holds a crack's opening too (there is no separate crack strain), so its unsoftened stress, and
+        ``kappa``, grow without bound as a crack opens: they say how far a crack opened, not what the slab carries
+        (docs/field.md, "Why the slab's stress read 20-124 times its strength"); :meth:`crack_cover` says how far
+        a crack went through the slab."""
         best = 0.0
         for g in self.groups:
             m = g.material
@@ -84,16 +91,24 @@ class SlabCrackDetector:
             F = H + np.eye(H.shape[1])
             b = np.einsum("nij,nkj->nik", F, F)
             eps = 0.5 * np.log(np.clip(np.linalg.eigvalsh(b), 1e-300, None))      # principal Hencky strains
-            s1 = (2.0 * m.mu * eps + m.lam * eps.sum(axis=1, keepdims=True)).max(axis=1)
+            tau = 2.0 * m.mu * eps + m.lam * eps.sum(axis=1, keepdims=True)
             kappa = g.kappa.numpy().astype(np.float64)
-            best = max(best, float(np.max(np.maximum(s1, kappa), initial=0.0)) / m.tensile_strength)
+            d = np.asarray(m.damage(kappa), dtype=np.float64).reshape(-1, 1)
+            carried = np.where(tau > 0.0, (1.0 - d) * tau, tau).max(axis=1, initial=-np.inf)
+            best = max(best, float(np.max(carried, initial=0.0)) / m.tensile_strength)
+            if np.any(kappa > m.tensile_strength):
+                best = max(best, 1.0)
         return best
 
-    def through_crack(self) -> float:
-        """Position (m from the cut end) of the first crack through the slab, nan if there is none."""
-        cracked = self.damage() >= THROUGH_DAMAGE
-        if not cracked.any():
-            return math.nan
+    def crack_cover(self) -> float:
+        """The largest share of the slab's particle rows (-) that fully damaged particles (damage >=
+        :data:`THROUGH_DAMAGE`) cover within one window one slab thickness wide: 0 uncracked, at least
+        :data:`THROUGH_COVER` for a crack through the slab (:meth:`through_crack`)."""
+        cover = self._cover(self.damage() >= THROUGH_DAMAGE)
+        return float(cover.max(initial=0.0))
+
+    def _cover(self, cracked: np.ndarray) -> np.ndarray:
+        """Per front bin: the share of the slab's rows with a ``cracked`` particle within the window around it."""
         nb = self.params.n_bins
         hit = np.zeros((nb + 1, self.n_rows), dtype=np.int32)
         hit[self.bins[cracked] + 1, self.rows[cracked]] = 1
@@ -101,7 +116,15 @@ class SlabCrackDetector:
         k = self.window
         lo = np.clip(np.arange(nb) - k // 2, 0, nb)
         hi = np.clip(np.arange(nb) + (k - k // 2), 0, nb)
-        cover = ((c[hi] - c[lo]) > 0).mean(axis=1)        # rows cracked within the window around each bin
+        return ((c[hi] - c[lo]) > 0).mean(axis=1)          # rows cracked within the window around each bin
+
+    def through_crack(self) -> float:
+        """Position (m from the cut end) of the first crack through the slab, nan if there is none."""
+        cracked = self.damage() >= THROUGH_DAMAGE
+        if not cracked.any():
+            return math.nan
+        nb, k = self.params.n_bins, self.window
+        cover = self._cover(cracked)
         through = np.nonzero(cover >= THROUGH_COVER)[0]
         if not len(through):
             return math.nan
