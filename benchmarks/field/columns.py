@@ -89,10 +89,10 @@ def main(argv=None) -> int:
                      "sim_time": [a.get("sim_time"), t.get("sim_time")], "steps": [a.get("steps"), t.get("steps")],
                      "shared_step_cost": t.get("shared_step_cost")})
     ok = [r for r in rows if r["status"] == ["ok", "ok"]]
-    n = len(chosen)
+    n = len(rows)                    # the cases set up and run (a drawn record the protocol refuses runs in neither)
     data = {"name": "field_columns", "environment": env, "device": args.device, "quick": args.quick,
             "draw": None if args.quick else {"per_class": args.per_class, "seed": args.seed, "limit": args.limit},
-            "cases": n, "columns": columns, "workers": workers,
+            "drawn": len(chosen), "cases": n, "columns": columns, "workers": workers,
             "alone": {"wall_s": wall_alone, "cases_per_hour": 3600.0 * n / wall_alone},
             "together": {"wall_s": wall_together, "cases_per_hour": 3600.0 * n / wall_together},
             "speedup": wall_alone / wall_together,

@@ -28,9 +28,10 @@ def render_columns(data: dict, ctx) -> list[str]:
     runs = [data] + ([ctx.load(CUDA)] if ctx.exists(CUDA) else [])
     ag = data["agreement"]
     out = [f"The first {data['draw']['limit']} cases of the development set's stratified draw (seed "
-           f"{data['draw']['seed']}; {data['cases']} of them runnable), each run twice by the field protocol into a "
-           "fresh folder: alone, then in groups stepped together (`mpm-warp field --columns N`), kernels compiled "
-           "beforehand by a first case. Wall times are the whole batch's, set-up and Dask included.", ""]
+           f"{data['draw']['seed']}; {data['cases']} of them set up by the protocol), each run twice by the "
+           "field protocol into a fresh folder: alone, then in groups stepped together (`mpm-warp field "
+           "--columns N`), kernels compiled beforehand by a first case. Wall times are the whole batch's, set-up "
+           "and Dask included.", ""]
     out += table(["device", "cases", "workers x threads", "wall (s)", "cases per hour", "against alone"],
                  [r for d in runs for r in _rows(d)], ["l", "l", "l", "r", "r", "r"])
     out += ["", f"- Both ways ran {ag['both_ok']} of the {data['cases']} cases; {ag['same_class']} kept their "
