@@ -137,5 +137,10 @@ def render_landing(data: dict, ctx) -> list[str]:
             f"call tells SF from END with an AUC of {fx(s['auc_peak_after'], 2)} ({s['sf_end_cases']} SF and END "
             "records)."
             + (" In the model, the landing damages the slab without breaking it through, in every class." if
-               through == 0 and above else ""), "", env_note(data)]
+               through == 0 and above else ""),
+            "- The peak stress column was read by the monitor of that commit, which took a cracked particle's "
+            "unsoftened stress: past a particle's strength it measures how far its crack opened, not what it "
+            "carries (never more than its strength). docs/field.md, \"Why the slab's stress read 20-124 times its "
+            "strength\", has the slab's carried stress: at most 0.38-0.45 of its strength up to the call on two "
+            "of these columns.", "", env_note(data)]
     return out
