@@ -245,7 +245,8 @@ class CrackingSnow(Elastic):
     fracture_energy : float
         Mode-I fracture energy ``G_f`` (J/m^2), > 0.
     band_width : float
-        Width ``h`` of the band a crack localises in (m), > 0: the grid spacing of the scene. At most
+        Width ``h`` of the band a crack localises in (m), > 0: 1.5 grid spacings at 2 particles per cell, the
+        width a crack breaks (docs/model.md §9). At most
         ``2 E G_f / sigma_t^2``, the width beyond which the softening would snap back.
     """
 

@@ -1,7 +1,7 @@
 """The limits that tie a PST's parameters together, checked by :meth:`~mpm_warp.scenes.pst.params.PSTParams.validate`.
 
 A layered slab or substratum replaces its homogeneous keys (:func:`check_layers`); a rigid base takes a sticky
-bed and no substratum (:func:`check_rigid_base`); a cracking slab's crack band, ``dx / particles_per_cell``,
+bed and no substratum (:func:`check_rigid_base`); a cracking slab's crack band, ``1.5 dx``,
 stays below each layer's largest (:func:`check_crack_band`); the interface closure takes layers at least a grid
 cell thick (:func:`check_closure_layers`). Each raises InvalidArgument naming ``where.key``, the value and why.
 """
@@ -66,6 +66,6 @@ def check_crack_band(p, where: str) -> None:
         name = f"{where}.slab_layers[{i}]" if p.slab_layers else f"{where}.slab"
         if p.crack_band >= mat.max_band_width:
             raise InvalidArgument(f"{where}.dx", p.dx, (
-                f"a spacing whose crack band dx/particles_per_cell stays below 2 E G_f / sigma_t^2 = "
+                f"a spacing whose crack band 1.5 dx stays below 2 E G_f / sigma_t^2 = "
                 f"{mat.max_band_width:.3g} m for {name} (sigma_t {mat.tensile_strength:.4g} Pa, G_f "
                 f"{mat.fracture_energy:.3g} J/m^2): wider, its softening snaps back"))
