@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 from .. import io
 from ..errors import InvalidArgument
+from ..scenes.pst.params import CRACK_BAND_CELLS
 from .batch_setup import Progress, check_out_dir, check_scheduler, dask_client, dask_log, iter_gather
 from .case_run import column_step, run_case, run_case_group, write_case_record
 from .cases import FieldCase, FieldRefusal
@@ -74,8 +75,12 @@ def gather(inputs, calibrate: bool = True, limit: int | None = None) -> tuple[li
 
 def case_digest(case: FieldCase, proto: FieldProtocol) -> str:
     """The key of ``case`` run under ``proto``: 12 hex digits of a digest of its parameters and the protocol (the
-    last part of its id; the same case set up again from its pit gets the same)."""
+    last part of its id; the same case set up again from its pit gets the same). The slab's crack band width in
+    grid cells enters too, now that it is no longer the half cell the first batches ran with (docs/model.md §9):
+    a case run with the old band is not reused as one of today's."""
     key = {"case": case.params.to_dict(), "protocol": proto.run_key()}
+    if CRACK_BAND_CELLS != 0.5:
+        key["crack_band_cells"] = CRACK_BAND_CELLS
     return hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
