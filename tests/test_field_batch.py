@@ -228,3 +228,21 @@ def test_a_protocol_with_the_closure_refuses_a_column_with_a_layer_thinner_than_
     assert main(["field", str(table), "--out", str(out), "--interface-closure", "--quiet"]) == 0
     with open(out / "refused.csv") as fh:
         assert "psts.csv#crust,PST 12/40 (End) down 15 cm,End,thin layer,\"the laminate closure needs" in fh.read()
+
+
+def test_a_brittle_slab_over_a_thick_weak_layer_gets_the_grid_its_crack_band_needs(tmp_path):
+    """A 6 cm layer under 40 cm of 350 kg/m^3: at 4 cells across the layer (13 mm) the slab's crack band, 1.5 cells,
+    would be wider than the snow's snap-back length 2 E G_f / sigma_t^2 (18.3 mm); the grid is refined to it."""
+    from mpm_warp.field.batch import case_scenario
+
+    table = tmp_path / "brittle.csv"
+    table.write_text("id,outcome,slope_deg,column_cm,cut_cm,slab_cm,slab_density,weak_layer_cm,weak_layer_density,w_f,"
+                     "column_ends\nthick,End,30,100,30,40,350,6,,0.5,\n")
+    (case,), refused = gather([str(table)])
+    assert refused == []
+    p = case.params
+    limit = min(ly.cracking(p.crack_band).max_band_width for ly in p.slab_stack())
+    assert limit == pytest.approx(0.0183, abs=5e-5)
+    assert p.dx < p.weak_layer_thickness / 4 and p.crack_band == pytest.approx(0.99 * limit)
+    scenario, note = case_scenario(case, FieldProtocol())
+    assert scenario is not None and note.startswith("4.3 cells across the weak layer, as the slab's crack band needs")

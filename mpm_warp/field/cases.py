@@ -19,6 +19,7 @@ from ..scenes.profile import ProfileError, PSTRecord, SnowProfileData, read_prof
 from ..scenes.profile.column import ProfileColumn, describe, profile_column
 from ..scenes.pst import PSTParams, Saw
 from ..scenes.pst.from_profile import CELLS_ACROSS
+from ..scenes.pst.params_checks import band_limited_dx
 from ..scenes.snowpack import SnowLayer
 from .fracture_energy import ImpliedFractureEnergy, implied_fracture_energy
 from .plain_words import in_field_terms
@@ -133,11 +134,13 @@ def _params(profile: SnowProfileData, rec: PSTRecord, col: ProfileColumn, base: 
     if sub and depth < base.substratum_thickness:     # the pit ends just under the weak layer: its last snow goes on
         sub[-1] = dataclasses.replace(sub[-1], thickness=sub[-1].thickness + base.substratum_thickness - depth)
     kw = {"substratum_layers": tuple(sub)}
-    return dataclasses.replace(
+    params = dataclasses.replace(
         base, dx=dx, margin=max(0.05, 2.0 * dx), length=float(rec.column_length), slope_angle=slope,
         column_ends=column_ends_for(profile.country), weak_layer_thickness=d_wl, weak_layer=weak,
         slab_layers=tuple(SnowLayer(p.thickness * c, p.density, name=p.name) for p in col.slab),
         saw=dataclasses.replace(base.saw, cut_length=float(rec.cut_length)), **kw)
+    fine = band_limited_dx(params)      # a brittle slab's crack band needs a finer grid than the weak layer's
+    return params if dx <= fine else dataclasses.replace(params, dx=fine, margin=max(0.05, 2.0 * fine))
 
 
 def field_case(profile: SnowProfileData, rec: PSTRecord, *, base: PSTParams | None = None,

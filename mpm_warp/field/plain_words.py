@@ -59,8 +59,9 @@ def in_field_terms(e: InvalidArgument, params) -> tuple[str, str]:
                               f"the {cell.rsplit('(', 1)[-1]} cell the weak layer sets: run this column without "
                               "--interface-closure")
     if field.endswith(".dx"):
-        return "grid", (f"the slab's snow is too brittle for the grid the {params.weak_layer_thickness * 100:.2g} cm "
-                        "weak layer sets (its crack band would be wider than the snow's fracture length)")
+        layer = f"the {params.weak_layer_thickness * 100:.2g} cm weak layer" if params is not None else "its weak layer"
+        return "grid", (f"the slab's snow is too brittle for the grid {layer} sets (its crack band would be wider "
+                        "than the snow's fracture length)")
     return "model range", f"outside the model's range: {_field_words(e)}"
 
 

@@ -5,7 +5,9 @@
   the crack's own. A crack that never runs away before the saw reaches the end is "no propagation".
 - **The grid** resolves the weak layer with 4 cells (the resolution the snow ladders call resolved) when the
   column then fits :attr:`FieldProtocol.max_particles`; else with 3, the fewest the model allows; else the
-  case is refused in one line (the column is too large for the budget).
+  case is refused in one line (the column is too large for the budget). A brittle slab's crack band (1.5
+  cells) must stay below its snap-back length ``2 E G_f / sigma_t^2``: where that needs a finer grid, the grid
+  is refined to it.
 - **The pre-cut**: each column starts sawn half of weac's critical cut at its fracture energy
   (``pre_cut_share``), as a slow saw would leave it; the blade goes on from there.
 - **The base**: the weak layer lies on a rigid base (``scene.rigid_base``), the column that weac reads the
@@ -25,6 +27,7 @@ from dataclasses import dataclass
 from ..config import TimeControl
 from ..errors import InvalidArgument
 from ..scenes.pst import PSTParams
+from ..scenes.pst.params_checks import band_limited_dx
 
 __all__ = ["FieldProtocol", "protocol_params", "decided", "particle_estimate", "run_to_decision",
            "run_until_decided"]
@@ -132,13 +135,16 @@ def protocol_params(params: PSTParams, proto: FieldProtocol, static_cut: float |
     saw = dataclasses.replace(params.saw, cut_length=float(params.length), speed=proto.saw_speed,
                               **({"stop": "runaway"} if "stop" in saw_fields else {}),
                               **({"pre_cut": min(pre, 0.5 * float(params.length))} if pre > 0.0 else {}))
+    fine = band_limited_dx(params)          # a brittle slab's crack band may need a finer grid than the layer's
     for cells in (proto.cells_across, 3):
-        dx = params.weak_layer_thickness / cells
+        dx = min(params.weak_layer_thickness / cells, fine)
         p = dataclasses.replace(params, dx=dx, margin=max(params.margin, 2.0 * dx), saw=saw)
         n = particle_estimate(p)
         if n <= proto.max_particles:
             end = p.saw_start + (p.length - p.saw.pre_cut) / proto.saw_speed + proto.tail
-            note = (f"{cells} cells across the weak layer, dx {dx * 1e3:.2f} mm, about {n:,} particles"
+            grid = (f"{cells} cells across the weak layer" if dx < fine else
+                    f"{p.weak_layer_thickness / dx:.1f} cells across the weak layer, as the slab's crack band needs")
+            note = (f"{grid}, dx {dx * 1e3:.2f} mm, about {n:,} particles"
                     + (", on a rigid base" if proto.rigid_base else "")
                     + (", laminate closure" if proto.interface_closure else "")
                     + (f", pre-cut {p.saw.pre_cut * 100:.1f} cm" if p.saw.pre_cut > 0.0 else ""))

@@ -59,6 +59,17 @@ def check_rigid_base(p, where: str) -> None:
                                   "= true (there is no substratum on a rigid base)")
 
 
+def band_limited_dx(p) -> float:
+    """The largest grid spacing (m) at which every slab layer's crack band (``CRACK_BAND_CELLS`` dx) stays below
+    its snap-back width ``2 E G_f / sigma_t^2``, with a 1 % margin; inf for a slab that cannot break."""
+    from .params import CRACK_BAND_CELLS
+
+    if not p.slab_fracture:
+        return float("inf")
+    widths = [layer.cracking(p.crack_band).max_band_width for layer in p.slab_stack()]
+    return 0.99 * min(widths) / CRACK_BAND_CELLS
+
+
 def check_crack_band(p, where: str) -> None:
     """Each slab layer's crack band below its largest, ``2 E G_f / sigma_t^2``."""
     for i, layer in enumerate(p.slab_stack()):
