@@ -39,7 +39,7 @@ from .case_run import column_step, run_case, run_case_group, write_case_record
 from .cases import FieldCase, FieldRefusal
 from .information_bar import CASE_FEATURES, case_record_features
 from .plain_words import in_field_terms
-from .protocol import FieldProtocol, protocol_params
+from .protocol import FieldProtocol, protocol_equivalent, protocol_params
 from .scores import field_class
 from .scoring import score_records
 from .static_view import static_view
@@ -74,8 +74,12 @@ def gather(inputs, calibrate: bool = True, limit: int | None = None) -> tuple[li
 
 def case_digest(case: FieldCase, proto: FieldProtocol) -> str:
     """The key of ``case`` run under ``proto``: 12 hex digits of a digest of its parameters and the protocol (the
-    last part of its id; the same case set up again from its pit gets the same)."""
+    last part of its id; the same case set up again from its pit gets the same). A case run with an equivalent weak
+    layer (:func:`~.protocol.protocol_equivalent`) has it in its key; the others keep the keys they had before."""
     key = {"case": case.params.to_dict(), "protocol": proto.run_key()}
+    eq = protocol_equivalent(case.params, proto)
+    if eq is not None and not isinstance(eq, str):
+        key["equivalent_layer"] = eq.key()
     return hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
