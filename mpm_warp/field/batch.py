@@ -40,7 +40,7 @@ from .case_run import column_step, run_case, run_case_group, write_case_record
 from .cases import FieldCase, FieldRefusal
 from .information_bar import CASE_FEATURES, case_record_features
 from .plain_words import in_field_terms
-from .protocol import FieldProtocol, protocol_params
+from .protocol import FieldProtocol, protocol_equivalent, protocol_params
 from .scores import field_class
 from .scoring import score_records
 from .static_view import static_view
@@ -77,10 +77,14 @@ def case_digest(case: FieldCase, proto: FieldProtocol) -> str:
     """The key of ``case`` run under ``proto``: 12 hex digits of a digest of its parameters and the protocol (the
     last part of its id; the same case set up again from its pit gets the same). The slab's crack band width in
     grid cells enters too, now that it is no longer the half cell the first batches ran with (docs/model.md §9):
-    a case run with the old band is not reused as one of today's."""
+    a case run with the old band is not reused as one of today's. A case run with an equivalent weak layer
+    (:func:`~.protocol.protocol_equivalent`) has it in its key."""
     key = {"case": case.params.to_dict(), "protocol": proto.run_key()}
     if CRACK_BAND_CELLS != 0.5:
         key["crack_band_cells"] = CRACK_BAND_CELLS
+    eq = protocol_equivalent(case.params, proto)
+    if eq is not None and not isinstance(eq, str):
+        key["equivalent_layer"] = eq.key()
     return hashlib.sha256(json.dumps(key, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 

@@ -5,9 +5,10 @@
   the crack's own. A crack that never runs away before the saw reaches the end is "no propagation".
 - **The grid** resolves the weak layer with 4 cells (the resolution the snow ladders call resolved) when the
   column then fits :attr:`FieldProtocol.max_particles`; else with 3, the fewest the model allows; else the
-  case is refused in one line (the column is too large for the budget). A brittle slab's crack band (1.5
-  cells) must stay below its snap-back length ``2 E G_f / sigma_t^2``: where that needs a finer grid, the grid
-  is refined to it.
+  column runs with an equivalent weak layer, thicker, with the real layer's fracture energy, strength, collapse
+  height and stiffness per unit area (:mod:`.equivalent_layer`), at 4 cells or else 3; else the case is refused
+  in one line (the column is too large for the budget). A brittle slab's crack band (1.5 cells) must stay below
+  its snap-back length ``2 E G_f / sigma_t^2``: where that needs a finer grid, the grid is refined to it.
 - **The pre-cut**: each column starts sawn half of weac's critical cut at its fracture energy
   (``pre_cut_share``), as a slow saw would leave it; the blade goes on from there.
 - **The base**: the weak layer lies on a rigid base (``scene.rigid_base``), the column that weac reads the
@@ -21,16 +22,16 @@
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
 
 from ..config import TimeControl
 from ..errors import InvalidArgument
 from ..scenes.pst import PSTParams
 from ..scenes.pst.params_checks import band_limited_dx
+from .equivalent_layer import equivalent_layer, equivalent_params, particle_estimate
 
-__all__ = ["FieldProtocol", "protocol_params", "decided", "particle_estimate", "run_to_decision",
-           "run_until_decided"]
+__all__ = ["FieldProtocol", "protocol_params", "protocol_column", "protocol_equivalent", "decided",
+           "particle_estimate", "run_to_decision", "run_until_decided"]
 
 
 @dataclass(frozen=True)
@@ -110,11 +111,29 @@ class FieldProtocol:
         return d
 
 
-def particle_estimate(p: PSTParams) -> int:
-    """Particles of the 2D column ``p`` (-): its area over the particle spacing squared."""
-    height = p.slab_depth + p.weak_layer_thickness + p.substratum_depth
-    spacing = p.dx / p.particles_per_cell
-    return int(math.ceil(p.length * height / spacing ** 2))
+def protocol_column(params: PSTParams, proto: FieldProtocol) -> PSTParams:
+    """The column ``params`` with the protocol's base and interfaces, before its grid and saw are set."""
+    if proto.interface_closure:
+        params = dataclasses.replace(params, interface_closure=True)
+    if proto.rigid_base:
+        bare = PSTParams()
+        params = dataclasses.replace(params, rigid_base=True, substratum_layers=(), substratum=bare.substratum,
+                                     substratum_thickness=bare.substratum_thickness)
+    return params
+
+
+def _fits(params: PSTParams, proto: FieldProtocol) -> bool:
+    """Whether the protocol's column ``params`` fits the budget with its own weak layer at 3 cells or more."""
+    return particle_estimate(dataclasses.replace(params, dx=params.weak_layer_thickness / 3)) <= proto.max_particles
+
+
+def protocol_equivalent(params: PSTParams, proto: FieldProtocol):
+    """The :class:`~.equivalent_layer.EquivalentLayer` the case ``params`` runs with under ``proto``, None when it
+    needs none (its own layer fits the budget), or the line saying why none fits (str). Arithmetic only."""
+    params = protocol_column(params, proto)
+    if _fits(params, proto):
+        return None
+    return equivalent_layer(params, dict.fromkeys((proto.cells_across, 3)), proto.max_particles)
 
 
 def protocol_params(params: PSTParams, proto: FieldProtocol, static_cut: float | None = None
@@ -122,35 +141,42 @@ def protocol_params(params: PSTParams, proto: FieldProtocol, static_cut: float |
     """The field case ``params`` as the protocol runs it: ``(params, time, note)``, or ``(None, None, reason)``.
 
     ``static_cut`` is weac's critical cut of the column (m; None: not critical, or not asked for), the pre-cut's
-    measure when the protocol has one.
+    measure when the protocol has one. A column over the budget at 3 cells runs with an equivalent weak layer
+    (:func:`protocol_equivalent`), which its note names.
     """
-    if proto.interface_closure:
-        params = dataclasses.replace(params, interface_closure=True)
-    if proto.rigid_base:
-        bare = PSTParams()
-        params = dataclasses.replace(params, rigid_base=True, substratum_layers=(), substratum=bare.substratum,
-                                     substratum_thickness=bare.substratum_thickness)
+    params = protocol_column(params, proto)
     saw_fields = {f.name for f in dataclasses.fields(params.saw)}
     pre = proto.pre_cut_share * static_cut if proto.pre_cut_share > 0.0 and static_cut else 0.0
     saw = dataclasses.replace(params.saw, cut_length=float(params.length), speed=proto.saw_speed,
                               **({"stop": "runaway"} if "stop" in saw_fields else {}),
                               **({"pre_cut": min(pre, 0.5 * float(params.length))} if pre > 0.0 else {}))
+    grids = [(cells, params.weak_layer_thickness / cells, None) for cells in (proto.cells_across, 3)]
+    if not _fits(params, proto):
+        eq = protocol_equivalent(params, proto)
+        if isinstance(eq, str):
+            n = particle_estimate(dataclasses.replace(params, dx=params.weak_layer_thickness / 3))
+            return None, None, (f"the column is too large for the per-case budget: {n:,} particles at the coarsest "
+                                f"grid the weak layer allows (3 cells), above {proto.max_particles:,}; {eq}")
+        grids, params = [(eq.cells, eq.dx, eq)], equivalent_params(params, eq.equivalent_thickness)
     fine = band_limited_dx(params)          # a brittle slab's crack band may need a finer grid than the layer's
-    for cells in (proto.cells_across, 3):
-        dx = min(params.weak_layer_thickness / cells, fine)
+    for cells, dx, eq in grids:
+        dx = min(dx, fine)
         p = dataclasses.replace(params, dx=dx, margin=max(params.margin, 2.0 * dx), saw=saw)
         n = particle_estimate(p)
         if n <= proto.max_particles:
             end = p.saw_start + (p.length - p.saw.pre_cut) / proto.saw_speed + proto.tail
             grid = (f"{cells} cells across the weak layer" if dx < fine else
                     f"{p.weak_layer_thickness / dx:.1f} cells across the weak layer, as the slab's crack band needs")
-            note = (f"{grid}, dx {dx * 1e3:.2f} mm, about {n:,} particles"
+            note = ((f"{eq.note()}, " if eq is not None else "")
+                    + f"{grid}, dx {dx * 1e3:.2f} mm, about {n:,} particles"
                     + (", on a rigid base" if proto.rigid_base else "")
                     + (", laminate closure" if proto.interface_closure else "")
                     + (f", pre-cut {p.saw.pre_cut * 100:.1f} cm" if p.saw.pre_cut > 0.0 else ""))
             return p.validate("scene"), TimeControl(end=end, frame_interval=proto.frame_interval), note
-    return None, None, (f"the column is too large for the per-case budget: {n:,} particles at the coarsest grid "
-                        f"the weak layer allows (3 cells), above {proto.max_particles:,}")
+    # only a brittle slab's finer grid gets here: the weak layer alone fits at 3 cells
+    return None, None, (f"the column is too large for the per-case budget: {n:,} particles at the grid its slab's "
+                        f"crack band needs (dx {dx * 1e3:.2f} mm: the slab's snow is too brittle for a coarser one), "
+                        f"above {proto.max_particles:,}")
 
 
 def decided(sim) -> bool:

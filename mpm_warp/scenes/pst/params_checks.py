@@ -60,14 +60,13 @@ def check_rigid_base(p, where: str) -> None:
 
 
 def band_limited_dx(p) -> float:
-    """The largest grid spacing (m) at which every slab layer's crack band (``CRACK_BAND_CELLS`` dx) stays below
-    its snap-back width ``2 E G_f / sigma_t^2``, with a 1 % margin; inf for a slab that cannot break."""
-    from .params import CRACK_BAND_CELLS
-
+    """The largest grid spacing (m) at which every slab layer's crack band (a fixed number of cells, ``crack_band /
+    dx``) stays below its snap-back width ``2 E G_f / sigma_t^2``, with a 1 % margin; inf for a slab that cannot
+    break."""
     if not p.slab_fracture:
         return float("inf")
     widths = [layer.cracking(p.crack_band).max_band_width for layer in p.slab_stack()]
-    return 0.99 * min(widths) / CRACK_BAND_CELLS
+    return 0.99 * min(widths) / (p.crack_band / p.dx)
 
 
 def check_crack_band(p, where: str) -> None:
