@@ -9,6 +9,12 @@ from .fmt import check_line, env_note, fx, table
 CUDA = "field/results/field_columns_cuda.json"
 
 
+def _work_ratio(d: dict) -> float:
+    """Particle-steps of the cases run together over those of the same cases alone (-)."""
+    ok = [r for r in d["rows"] if r["status"] == ["ok", "ok"]]
+    return sum(r["particles"] * r["steps"][1] for r in ok) / sum(r["particles"] * r["steps"][0] for r in ok)
+
+
 def _rows(d: dict) -> list[list]:
     dev = d["environment"].get("device_name") or d["device"]
     w = d["workers"]
@@ -38,7 +44,11 @@ def render_columns(data: dict, ctx) -> list[str]:
             f"class and {ag['same_runaway_cut_1cm']} their runaway cut within 1 cm.",
             f"- The shared step cost a column {fx(ag['shared_step_cost_median'], 2)} times its own steps at the "
             f"median and {fx(ag['shared_step_cost_max'], 2)} at most (its own elastic step over its group's "
-            "least; docs/architecture.md, \"Columns stepped together\").", ""]
+            "least; docs/architecture.md, \"Columns stepped together\"): the groups took "
+            f"{fx(_work_ratio(data), 2)} times the particle-steps of the cases alone.",
+            "- On the CPU a group runs its columns one after another on one thread, so it saves nothing there: it "
+            "pays the shared step's extra steps, and its slowest group ends the batch. Groups are for a GPU, which "
+            "one column leaves idle.", ""]
     if not ctx.exists(CUDA):
         out += ["No GPU run is committed yet: `bash benchmarks/device_suite.sh` runs a small field batch on one "
                 "(its `field` part), and `python benchmarks/field/columns.py DIR --device cuda --columns 64` this "
