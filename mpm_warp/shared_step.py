@@ -17,6 +17,7 @@ import warp as wp
 from .errors import InvalidArgument, SimulationBlowUp
 from .health import MIN_DT_SHARE
 from .kernels.shared_dt import least_dt_kernel, offer_dt_kernel, take_dt_kernel
+from .step import replay_captured
 
 __all__ = ["SharedStep"]
 
@@ -98,14 +99,7 @@ class SharedStep:
         if n <= 0 or not self.active:
             return
         if self.use_graph:
-            if self._graph is None:
-                with wp.ScopedCapture(device=self.device) as cap:
-                    for _ in range(self.graph_batch):
-                        self._launch_step()
-                self._graph = cap.graph
-            for _ in range(n // self.graph_batch):
-                wp.capture_launch(self._graph)
-            n = n % self.graph_batch
+            n = replay_captured(self, self.device, n)
         with self.sims[self.active[0]].stepper.flushed(0):
             for _ in range(n):
                 self._launch_step()

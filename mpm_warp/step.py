@@ -30,7 +30,7 @@ from .meeting import MeetingPoint
 from .model import Model, State
 from .step_profile import refuse_no_ops, stage_walls, timed
 
-__all__ = ["Stepper", "default_threads", "grid_copies"]
+__all__ = ["Stepper", "default_threads", "grid_copies", "replay_captured"]
 
 
 def default_threads(device: str, n_particles: int) -> int:
@@ -54,6 +54,20 @@ def grid_copies(device: str, n_particles: int, grid_shape, n_threads: int | None
 
 def _no_wait() -> None:  # the meeting of a one-thread step: nothing to wait for
     pass
+
+
+def replay_captured(owner, device, n: int) -> int:
+    """Replay ``owner``'s captured CUDA graph of ``owner.graph_batch`` steps ``n // graph_batch`` times, capturing
+    ``owner._launch_step`` that many times into ``owner._graph`` first when there is none; return the steps left
+    to run eagerly (``n % graph_batch``)."""
+    if owner._graph is None:
+        with wp.ScopedCapture(device=device) as cap:
+            for _ in range(owner.graph_batch):
+                owner._launch_step()
+        owner._graph = cap.graph
+    for _ in range(n // owner.graph_batch):
+        wp.capture_launch(owner._graph)
+    return n % owner.graph_batch
 
 
 class Stepper:
@@ -160,8 +174,12 @@ class Stepper:
             launch.launch()
 
     def _before_scatter(self) -> None:
-        """The serial launches before P2G: step size, walls, actions (saw, monitors), interface closure."""
+        """The serial launches before P2G: step size, then :meth:`_serial_before`."""
         self._begin.launch()
+        self._serial_before()
+
+    def _serial_before(self) -> None:
+        """The serial launches between the step size and P2G: walls, actions (saw, monitors), interface closure."""
         if self._wall_state is not None:
             self._wall_state.launch()
         for a in self.actions:
@@ -233,12 +251,7 @@ class Stepper:
         one for many columns between the two parts): walls, actions, closure, P2G, grid, G2P, clock."""
         if self.n_threads != 1:
             raise InvalidArgument("n_threads", self.n_threads, "1 for a column stepped with others")
-        if self._wall_state is not None:
-            self._wall_state.launch()
-        for a in self.actions:
-            a.launch()
-        for launch in self._closure:
-            launch.launch()
+        self._serial_before()
         self._scatter(0)
         self._grid[0].launch()
         self._g2p[0].launch()
@@ -270,14 +283,7 @@ class Stepper:
         if n <= 0:
             return
         if self.use_graph:
-            if self._graph is None:
-                with wp.ScopedCapture(device=self.model.device) as cap:
-                    for _ in range(self.graph_batch):
-                        self._launch_step()
-                self._graph = cap.graph
-            for _ in range(n // self.graph_batch):
-                wp.capture_launch(self._graph)
-            n = n % self.graph_batch
+            n = replay_captured(self, self.model.device, n)
         if n > 0:
             self._team_steps(n)
 
