@@ -9,6 +9,7 @@ import pytest
 
 from mpm_warp.cli import main
 from mpm_warp.field.batch import finished_records, gather, run_field, score_records
+from mpm_warp.field.probability import weibull_break_probability
 from mpm_warp.field.protocol import FieldProtocol
 from mpm_warp.field.scores import baseline_majority, scores
 from mpm_warp.field.table import table_profiles
@@ -85,6 +86,9 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     # ratio at the recorded cut and the information bar's numbers (the 12 cm cut of a 40 cm column: 0.3)
     for r in again.records:
         assert r["slab_peak_stress_ratio"] > 0.0 and r["static_peak_ratio"] > 0.0
+        # the slab's body (its rows the grid does not tie to the weak layer) carries no more than the whole slab
+        assert 0.0 < r["slab_peak_body_stress_ratio"] <= r["slab_peak_stress_ratio"]
+        assert r["p_sf"] == pytest.approx(weibull_break_probability(min(r["slab_peak_body_stress_ratio"], 1.0)))
         assert r["p_end"] + r["p_sf"] + r["p_arr"] == pytest.approx(1.0)
         assert r["slab_depth"] == pytest.approx(0.15) and r["slab_density"] == pytest.approx(180.0)
     assert again.records[0]["cut_share"] == pytest.approx(0.3)
@@ -110,6 +114,21 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     assert os.stat(run_file).st_mtime_ns == before
     assert went["sim_time_after"] == pytest.approx(0.01, abs=0.006)       # to the frame at or past 0.01 s
     assert went["peak_stress_ratio_before"] == pytest.approx(case["slab_peak_stress_ratio"])
+    # the slab's body at the call, from the final checkpoint: with no rows left out it is the whole slab's reading
+    # at the last frame; leaving out the rows the grid ties to the weak layer can only lower it; no body, None
+    import h5py
+
+    from mpm_warp.field.run_on import scenario_of
+    from mpm_warp.field.studies.at_call import body_stress_ratio, case_readings
+
+    sc = scenario_of(out, case["id"])
+    with h5py.File(run_file, "r") as f:
+        last = float(f["scalars"]["slab_stress_ratio"][-1])
+        last_body = float(f["scalars"]["slab_body_stress_ratio"][-1])
+    assert body_stress_ratio(out, case["id"], sc, tie_cells=-1.0) == pytest.approx(last, rel=1e-6)
+    body = case_readings(out, case["id"], sc)["slab_body_stress_ratio_at_call"]
+    assert body == pytest.approx(last_body, rel=1e-6) and 0.0 < body <= last     # the monitor's, at the last frame
+    assert body_stress_ratio(out, case["id"], sc, tie_cells=100.0) is None       # 15 cm of slab: no body
 
 
 def test_bad_batch_arguments_are_one_line(tmp_path, capsys):

@@ -189,6 +189,21 @@ def test_the_run_summary_line_of_the_probabilities():
     assert line.startswith("  P(END) 0.74, P(SF) 0.26, P(ARR) 0.00 (the slab's peak stress 0.50 x its strength")
     assert probability_line({"class": None, "slab_peak_stress_ratio": 0.5}) == ""
     assert probability_line({"class": "END"}) == ""                      # a slab that cannot break
+    # the slab's body, where the run read it, before the whole slab (whose base rows the weak layer cracks)
+    line = probability_line({"class": "END", "slab_peak_stress_ratio": 1.0, "slab_peak_body_stress_ratio": 0.5})
+    assert line.startswith("  P(END) 0.74, P(SF) 0.26, P(ARR) 0.00 (the slab body's peak stress 0.50 x its")
+
+
+def test_the_slab_reading_takes_the_body_first():
+    from mpm_warp.field.probability import slab_reading
+
+    rec = {"slab_peak_stress_ratio": 1.0}
+    assert slab_reading(rec) == (1.0, "slab_peak_stress_ratio")
+    assert slab_reading({**rec, "slab_body_stress_ratio_at_call": 0.2}) == (0.2, "slab_body_stress_ratio_at_call")
+    assert slab_reading({**rec, "slab_body_stress_ratio_at_call": 0.2, "slab_peak_body_stress_ratio": 0.3}) == (
+        0.3, "slab_peak_body_stress_ratio")
+    assert slab_reading({"slab_peak_body_stress_ratio": float("nan"), **rec}) == (1.0, "slab_peak_stress_ratio")
+    assert slab_reading({}) == (None, None)
 
 
 def test_touchdown_distance_and_brittleness_of_a_homogeneous_slab_by_hand():

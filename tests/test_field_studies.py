@@ -100,3 +100,25 @@ def test_the_slab_stress_readers_give_the_onset_and_the_peaks():
     assert run_layers_to({"series": series}, 0.2) == [0.3, 0.5]
     assert run_layers_to({"series": series}, 0.2, last=True) == [0.2, 0.5]
     assert run_layers_to({"series": series}, None) is None
+
+
+def test_the_readings_at_the_call_are_the_last_frame_and_the_peaks():
+    from mpm_warp.errors import InvalidArgument
+    from mpm_warp.field.studies.at_call import AT_CALL_KEYS, readings_at_call
+
+    nan = float("nan")
+    series = {"front": [nan, 0.2, 0.5, 0.8], "deflection_front": [nan, 0.0, 0.1, 0.2],
+              "marker0_uy": [0.0, -1e-4, -5e-4, -9e-4], "marker1_uy": [0.0, 0.0, -1e-4, -3e-4],
+              "marker1_ux": [0.0, 0.0, -1e-2, -1e-2], "slab_stress_ratio": [0.1, 0.4, 0.3, 0.35],
+              "slab_crack_cover": [0.0, 0.0, 0.05, 0.02]}
+    r = readings_at_call(series, 4.5e-3)
+    assert set(r) == set(AT_CALL_KEYS)
+    assert r["slab_drop_at_call"] == pytest.approx(0.2)           # 0.9 mm of 4.5 mm at the last frame
+    assert r["slab_down_share"] == pytest.approx(0.25)            # 0.2 m of 0.8 m cracked
+    assert r["slab_stress_ratio"] == pytest.approx(0.4)           # the peak, not the last frame
+    assert r["slab_crack_cover"] == pytest.approx(0.05)
+    # a deflection front ahead of the damage front (end zone lift) counts the whole crack; a run without one: None
+    assert readings_at_call({"front": [0.5], "deflection_front": [0.7]}, 4.5e-3)["slab_down_share"] == 1.0
+    assert readings_at_call({"marker0_uy": [-1e-3]}, 4.5e-3)["slab_down_share"] is None
+    with pytest.raises(InvalidArgument, match="collapse_height"):
+        readings_at_call(series, 0.0)

@@ -137,6 +137,16 @@ def test_the_slab_stress_ratio_is_the_stress_the_slab_carries():
     assert ratio(((e, 0.0), 22.5e3)) == 1.0
     # an open crack stretched to e = 0.05: its unsoftened stress is 300 kPa, 60 times the strength; it carries none
     assert ratio(((0.05, 0.0), 6e6 * 0.05), ((1e-4, 0.0), 0.0)) == 1.0
+    # the body: a cracked base row (y = 0) below an intact body (y = 0.05 m, 600 Pa) reads 1 over the whole slab
+    # and 0.12 over the body above 0.03 m; a slab all below it has no body
+    parts = (((e, 0.0), 22.5e3), ((1e-4, 0.0), 0.0))
+    H = np.array([R @ np.diag(np.exp(p)) @ R.T - np.eye(2) for p, _ in parts])
+    g = SimpleNamespace(material=mat, H=_Host(H), kappa=_Host([k for _, k in parts]),
+                        x0=np.array([[0.1, 0.0], [0.1, 0.05]]))
+    params = pst.PSTParams()
+    det = SlabCrackDetector(params, [g], body_above=0.03)
+    assert det.stress_ratio() == 1.0 and det.body_stress_ratio() == pytest.approx(0.12, rel=1e-6)
+    assert math.isnan(SlabCrackDetector(params, [g], body_above=0.06).body_stress_ratio())
 
 
 @pytest.mark.slow

@@ -6,7 +6,9 @@ the slope, the cut as a share of the column, where the weak layer's fracture ene
 the recorded cut, or the default), the run's runaway cut against the recorded one, and whether the slab
 cracked anywhere (its largest effective tensile stress over its strength, from the final checkpoint: ``kappa``,
 docs/model.md §9), and whether a static energy balance could stop the crack before the far end: the least of
-weac's energy release rate (with touchdown) beyond the recorded cut over the fracture energy the run took.
+weac's energy release rate (with touchdown) beyond the recorded cut over the fracture energy the run took, and
+what the slab had done at the run's call (``mpm_warp.field.studies.at_call``: its collapse, the share of the crack
+it had come down over, the most it carried and how far a crack went through it).
 Groups them by observed and predicted class. Nothing here changes the model: it is the
 evidence for which physics is missing. Writes ``benchmarks/field/results/field_disagreements.json``.
 
@@ -23,6 +25,7 @@ import warnings
 
 from mpm_warp.field.batch import gather, run_records
 from mpm_warp.field.run_on import scenario_of
+from mpm_warp.field.studies.at_call import case_readings
 from mpm_warp.scenes.pst.outcome import FIELD_CLASSES
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -99,7 +102,7 @@ def describe(rec: dict, case, run_dir: str) -> dict:
             "c_p_over_slab": dt_ratio, "fastest_material": fastest,
             "rigid_base": bool(sc.scene.rigid_base) if sc is not None else None,
             "particles": rec.get("particles"), "steps": rec.get("steps"),
-            "wall_s": rec.get("wall_s")}
+            "wall_s": rec.get("wall_s"), **case_readings(run_dir, rec["id"], sc)}
 
 
 def _median(xs):

@@ -1,9 +1,11 @@
 """How do the model's outcome probabilities score against the references, as a forecaster scores them?
 
 Scores a field batch's finished cases (``field_batch.py --runs RUNDIR``, resumed or stopped early) with
-``mpm_warp.field.scoring``: the model's first-order probabilities (its run's slab stress under snow's Weibull
-strength scatter), the set's climatology, the majority class and weac's static rule as sure forecasts, and the
-information bar (a logistic regression on slab depth, density, slope and cut share, cross-validated by pit).
+``mpm_warp.field.scoring``: the model's first-order probabilities (its run's slab-body stress under snow's Weibull
+strength scatter; a run recorded before the body's series is read at its call from its final checkpoint,
+``mpm_warp.field.studies.at_call``), the set's climatology, the majority class and weac's static rule as sure
+forecasts, and the information bar (a logistic regression on slab depth, density, slope and cut share,
+cross-validated by pit).
 Ranked probability skill against the climatology, Brier score per class, one-vs-rest AUC for SF and ARR,
 balanced accuracy of the most probable class, each with paired bootstrap intervals; and the reliability
 diagram. Writes ``benchmarks/field/results/field_forecast.json`` and ``field_forecast.png``.
@@ -22,6 +24,7 @@ import warnings
 import numpy as np
 
 from mpm_warp.field.draw import finished_draw
+from mpm_warp.field.probability import slab_reading
 from mpm_warp.field.scores import FIELD_CLASSES
 from mpm_warp.field.scoring import forecasts, score_records, scored
 from mpm_warp.studies.environment import environment, write_json
@@ -58,6 +61,17 @@ def reliability_figure(sc: dict, path: str) -> None:
     plt.close(fig)
 
 
+def body_at_call(recs: list[dict], runs: str) -> None:
+    """Give each finished record without the body's series its slab body's stress at the call, from its final
+    checkpoint (``slab_body_stress_ratio_at_call``; the reading the model's probability takes then)."""
+    from mpm_warp.field.run_on import scenario_of
+    from mpm_warp.field.studies.at_call import body_stress_ratio
+
+    for r in scored(recs):
+        if r.get("slab_peak_body_stress_ratio") is None:
+            r["slab_body_stress_ratio_at_call"] = body_stress_ratio(runs, r["id"], scenario_of(runs, r["id"]))
+
+
 def made_up(n: int = 30, seed: int = 0) -> list[dict]:
     """A small made-up batch (``--quick``): three classes, two cases a pit, a model that half knows SF."""
     rng = np.random.default_rng(seed)
@@ -85,6 +99,7 @@ def main(argv=None) -> int:
         if not (args.data and args.runs):
             p.error("DIR and --runs are needed without --quick")
         recs, selection = finished_draw(args.data, args.runs, args.per_class, args.seed)
+        body_at_call(recs, args.runs)
     ok = scored(recs)
     made = forecasts(ok)
     sc = score_records(recs, probs=made)
@@ -92,6 +107,7 @@ def main(argv=None) -> int:
     dest = out_dir(args, RESULTS, "field_forecast")
     data = {"name": "field_forecast", "environment": environment("cpu"), "selection": selection, "scores": sc,
             "cases": [{"id": r["id"], "observed": r["observed"], "predicted": r["predicted"],
+                       "slab_reading": slab_reading(r)[1],
                        **{name: [float(x) for x in pr[i]] for name, pr in probs.items() if name != "climatology"}}
                       for i, r in enumerate(ok)]}
     path = write_json("field_forecast", data, dest)

@@ -37,6 +37,11 @@ CANDIDATES = {
     "slab_depth": ("the slab's bed-normal depth (m), recorded", -1),
     "slab_density": ("the slab's mean density (kg/m^3), recorded or from hardness and grain", -1),
     "run_slab_crack_ratio": ("the run's largest slab kappa over strength (-), 0 below strength", +1),
+    "run_slab_stress_ratio": ("the run's largest stress the slab carried over its strength, to the call (-)", +1),
+    "run_slab_crack_cover": ("the run's largest share of slab rows cracked through at one place (-)", +1),
+    "run_slab_body_stress_ratio": ("the stress the run's slab body carried at the call over its strength (-)", +1),
+    "run_slab_drop_at_call": ("the run's largest slab-base drop at the call over the collapse height (-)", +1),
+    "run_slab_down_share": ("the run's share of the crack over which the slab had come down at the call (-)", +1),
     "static_peak_ratio": ("weac's slab peak stress over strength at the recorded cut (-)", +1),
     "touchdown_distance": ("Heierli's touchdown distance of the slab (m)", -1),
     "touchdown_over_column": ("the touchdown distance over the column's length (-)", -1),
@@ -56,6 +61,9 @@ def describe(row: dict, case) -> dict:
     return {"id": row["id"], "observed": row["observed"], "predicted": row["predicted"],
             "slab_depth": row["slab_depth_m"], "slab_density": row["slab_density"],
             "run_slab_crack_ratio": row.get("slab_crack_ratio"),
+            "run_slab_stress_ratio": row.get("slab_stress_ratio"), "run_slab_crack_cover": row.get("slab_crack_cover"),
+            "run_slab_body_stress_ratio": row.get("slab_body_stress_ratio_at_call"),
+            "run_slab_drop_at_call": row.get("slab_drop_at_call"), "run_slab_down_share": row.get("slab_down_share"),
             "static_peak_ratio": weac_static_rule(p)["peak_ratio"], "touchdown_distance": td,
             "touchdown_over_column": td / p.length, "brittleness": brittleness(p), "column_m": p.length}
 
@@ -132,7 +140,8 @@ def main(argv=None) -> int:
             "information_bar": information_bar_scores(rows, described), "cases": described}
     path = write_json("field_mechanisms", data, out_dir(args, RESULTS, "field_mechanisms"))
     for key, v in data["candidates"].items():
-        print(f"{key:24s} SF/END AUC {v['sf_vs_end']['auc']:.3f}  ARR/rest AUC {v['arr_vs_rest']['auc']:.3f}")
+        a, b = v["sf_vs_end"]["auc"], v["arr_vs_rest"]["auc"]
+        print(f"{key:24s} SF/END AUC {a if a is None else round(a, 3)}  ARR/rest AUC {b if b is None else round(b, 3)}")
     print(f"{path}: {len(described)} cases")
     return 0
 

@@ -353,8 +353,8 @@ def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Pro
 #: the columns of cases.csv
 CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "p_end", "p_sf", "p_arr", "static_class",
                 "static_peak_ratio", "recorded_cut", "runaway_cut", "slab_fracture_at", "slab_peak_stress_ratio",
-                *CASE_FEATURES, "w_f", "w_f_source", "setup", "particles", "steps", "threads", "workers", "wall_s",
-                "run_file", "error")
+                "slab_peak_body_stress_ratio", *CASE_FEATURES, "w_f", "w_f_source", "setup", "particles", "steps",
+                "threads", "workers", "wall_s", "run_file", "error")
 
 
 def _write_outputs(out_dir: str, recs: list, refused: list) -> None:

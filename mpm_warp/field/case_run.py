@@ -15,7 +15,7 @@ import traceback
 
 from .. import io
 from .information_bar import CASE_FEATURES
-from .probability import outcome_probability
+from .probability import outcome_probability, slab_reading
 from .protocol import decided, run_to_decision
 
 __all__ = ["run_case", "run_case_group", "write_case_record", "column_step"]
@@ -56,9 +56,10 @@ def _finish(rec: dict, task: dict, res, threads) -> None:
                runaway_cut=_finite(res.scene_result.get("runaway_cut")),
                slab_fracture_at=_finite(o.get("slab_fracture_at")), note=o.get("note", ""),
                slab_peak_stress_ratio=_finite(o.get("slab_peak_stress_ratio")),
+               slab_peak_body_stress_ratio=_finite(o.get("slab_peak_body_stress_ratio")),
                sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
                threads=threads, workers=task.get("workers"), n_frames=io.read_run(out + ".part.h5").n_frames)
-    prob = outcome_probability(rec["predicted"], rec["slab_peak_stress_ratio"])
+    prob = outcome_probability(rec["predicted"], slab_reading(rec)[0])
     if prob is not None:
         rec["p_end"], rec["p_sf"], rec["p_arr"] = prob
     io.promote_part(out)

@@ -1,8 +1,9 @@
 """A field case's outcome as a probability: a first-order reading of its one run under snow's strength scatter.
 
 Snow's tensile strength scatters from sample to sample as a Weibull law of modulus 1.5 (+- 0.5) with no size
-effect (Phys. Rev. E 69, 011306, 2004). The run's slab carried at most ``r`` times its density law's strength
-(``slab_peak_stress_ratio``, the largest over the frames; 1 where it cracked): a slab whose strength is
+effect (Phys. Rev. E 69, 011306, 2004). The run's slab body carried at most ``r`` times its density law's strength
+(:func:`slab_reading`: ``slab_peak_body_stress_ratio``, the largest over the frames, 1 where it cracked; the rows
+the grid ties to the weak layer are left out, docs/field.md): a slab whose strength is
 drawn below ``r`` times the law's breaks. Taking the law as the distribution's mean, ``P(SF) = 1 - exp(-(r
 Gamma(1 + 1/m))^m)`` with ``r`` capped at 1, since a crack that formed says the stress reached the strength and
 not how far beyond it a stronger slab would have been loaded. The rest goes to the run's own class (END for a
@@ -17,10 +18,26 @@ import math
 
 from ..scenes.pst.outcome import CLASSES
 
-__all__ = ["WEIBULL_MODULUS", "weibull_break_probability", "outcome_probability", "probability_line"]
+__all__ = ["WEIBULL_MODULUS", "SLAB_READINGS", "weibull_break_probability", "slab_reading", "outcome_probability",
+           "probability_line"]
 
 #: Weibull modulus of snow's tensile strength (-), Phys. Rev. E 69, 011306 (2004)
 WEIBULL_MODULUS = 1.5
+
+#: the slab readings a record or an outcome may carry, the first present taken (:func:`slab_reading`): the body's
+#: peak over the run's frames, the body's at the call read from the final checkpoint (a run recorded before the
+#: body's series), the whole slab's peak (a run recorded before the body's reading)
+SLAB_READINGS = ("slab_peak_body_stress_ratio", "slab_body_stress_ratio_at_call", "slab_peak_stress_ratio")
+
+
+def slab_reading(rec: dict) -> tuple[float | None, str | None]:
+    """``(r, key)``: the first finite reading of :data:`SLAB_READINGS` in ``rec`` (a record or an outcome), and its
+    key; ``(None, None)`` without one."""
+    for key in SLAB_READINGS:
+        r = rec.get(key)
+        if isinstance(r, (int, float)) and r == r:
+            return float(r), key
+    return None, None
 
 
 def weibull_break_probability(ratio: float, modulus: float = WEIBULL_MODULUS) -> float:
@@ -46,9 +63,12 @@ def outcome_probability(predicted: str | None, slab_peak_stress_ratio: float | N
 
 def probability_line(outcome: dict) -> str:
     """``  P(END) 0.63, P(SF) 0.37, P(ARR) 0.00 (...)`` and a newline for a PST run's ``outcome`` (its class and
-    ``slab_peak_stress_ratio``), or "" where it has no probability (a slab that cannot break, a run not decided)."""
-    p = outcome_probability(outcome.get("class"), outcome.get("slab_peak_stress_ratio"))
+    its slab's reading, :func:`slab_reading`), or "" where it has no probability (a slab that cannot break, a run
+    not decided)."""
+    r, key = slab_reading(outcome)
+    p = outcome_probability(outcome.get("class"), r)
     if p is None:
         return ""
-    return (f"  P(END) {p[0]:.2f}, P(SF) {p[1]:.2f}, P(ARR) {p[2]:.2f} (the slab's peak stress "
-            f"{outcome['slab_peak_stress_ratio']:.2f} x its strength, under snow's Weibull strength scatter)\n")
+    what = "the slab body's peak stress" if "body" in key else "the slab's peak stress"
+    return (f"  P(END) {p[0]:.2f}, P(SF) {p[1]:.2f}, P(ARR) {p[2]:.2f} ({what} {r:.2f} x its strength, under "
+            "snow's Weibull strength scatter)\n")

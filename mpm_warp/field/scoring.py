@@ -19,7 +19,7 @@ import numpy as np
 from .forecast import climatology, forecast_scores, one_hot
 from .forecast_intervals import forecast_intervals
 from .information_bar import case_features, fold_count, information_bar
-from .probability import outcome_probability
+from .probability import outcome_probability, slab_reading
 from .scores import baseline_majority, scores
 from .uncertainty import balanced_accuracy_intervals
 
@@ -42,7 +42,7 @@ def model_forecast(recs: list) -> np.ndarray | None:
         if r.get("predicted") == "running":
             rows.append((1.0 / 3.0,) * 3)
             continue
-        p = outcome_probability(r.get("predicted"), r.get("slab_peak_stress_ratio"))
+        p = outcome_probability(r.get("predicted"), slab_reading(r)[0])
         if p is None:
             return None
         rows.append(p)

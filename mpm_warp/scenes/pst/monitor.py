@@ -13,7 +13,7 @@ from ..weak_layer import ReferenceField, WeakLayerTracker, bin_median, stored_ca
 from .analysis import end_zone, pst_summary, runaway_cut
 from .build import layer_names
 from .kernels import deflection_kernel
-from .outcome import SlabCrackDetector, classify
+from .outcome import TIE_CELLS, SlabCrackDetector, classify
 from .params import PSTParams
 from .saw import blade_position, sawn, stop_record
 from .static import weac_answer
@@ -93,7 +93,9 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         self.marker_index = zsel[np.argmin(np.abs(x0[zsel, 0][None, :] - self.markers[:, None]), axis=1)]
         #: the slab's through-crack finder (a slab that can break only)
         slab_groups = [sim.group_state(n) for n in layer_names("slab", len(p.slab_stack()))]
-        self.slab_crack = SlabCrackDetector(p, slab_groups) if p.slab_fracture else None
+        top = float(self.weak.group.x0[:, 1].max())          # the weak layer's top particles: the grid's tie above
+        self.slab_crack = (SlabCrackDetector(p, slab_groups, body_above=top + TIE_CELLS * sim.model.dx)
+                           if p.slab_fracture else None)
 
     # ----------------------------------------------------------------- contract
     def actions(self) -> list:
@@ -106,6 +108,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         if self.slab_crack is not None:
             u["slab_crack"] = "m"
             u["slab_stress_ratio"] = "-"
+            u["slab_body_stress_ratio"] = "-"
             u["slab_crack_cover"] = "-"
         for k in range(len(self.markers)):
             u[f"marker{k}_ux"] = "m"
@@ -126,6 +129,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         if self.slab_crack is not None:
             out["slab_crack"] = self.slab_crack.through_crack()
             out["slab_stress_ratio"] = self.slab_crack.stress_ratio()
+            out["slab_body_stress_ratio"] = self.slab_crack.body_stress_ratio()
             out["slab_crack_cover"] = self.slab_crack.crack_cover()
         c, sawn = self.weak.collapse()
         gone = (self.weak.bond() <= 0.0) & (sawn == 0) & self.interior
@@ -197,6 +201,9 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
         ratio = np.asarray(series.get("slab_stress_ratio", []), dtype=float)
         if ratio.size and np.isfinite(ratio).any():     # the slab's peak over its strength at the frames so far
             out["slab_peak_stress_ratio"] = float(np.nanmax(ratio))
+        body = np.asarray(series.get("slab_body_stress_ratio", []), dtype=float)
+        if body.size and np.isfinite(body).any():       # the same over the slab's body (what the probability reads)
+            out["slab_peak_body_stress_ratio"] = float(np.nanmax(body))
         cover = np.asarray(series.get("slab_crack_cover", []), dtype=float)
         if cover.size and np.isfinite(cover).any():     # how far a crack went through the slab, at most
             out["slab_peak_crack_cover"] = float(np.nanmax(cover))

@@ -30,8 +30,9 @@ import numpy as np
 from .analysis import crack_ran, end_zone
 from .params import PSTParams
 
-__all__ = ["SlabCrackDetector", "classify", "field_line", "front_stalled", "FIELD_CLASSES", "CLASSES", "THROUGH_DAMAGE",
-           "THROUGH_COVER", "STALL_TIME"]
+__all__ = ["SlabCrackDetector", "carried_over_strength",
+           "classify", "field_line", "front_stalled", "FIELD_CLASSES", "CLASSES", "THROUGH_DAMAGE",
+           "THROUGH_COVER", "STALL_TIME", "TIE_CELLS"]
 
 #: the field's three classes, in the order of the forecast scores (docs/field.md): the one home of their spelling
 FIELD_CLASSES = ("END", "SF", "ARR")
@@ -44,6 +45,35 @@ THROUGH_DAMAGE = 0.95
 THROUGH_COVER = 0.9
 #: a front that has not advanced for this long (s) at the end of a run has arrested
 STALL_TIME = 0.05
+#: grid cells above the weak layer's top particles within which a slab particle's quadratic B-spline stencil
+#: (1.5 cells each way) shares a grid node with theirs: the slab's rows the grid ties to the weak layer, outside
+#: the slab's body (:meth:`SlabCrackDetector.body_stress_ratio`)
+TIE_CELLS = 3.0
+
+
+def carried_over_strength(H: np.ndarray, kappa: np.ndarray, material) -> np.ndarray:
+    """Per particle, the largest tensile stress it carries over its material's tensile strength (-), 1 where its
+    ``kappa`` passed the strength (:meth:`SlabCrackDetector.stress_ratio`).
+
+    Parameters
+    ----------
+    H : ndarray (n, d, d)
+        ``F_E - I`` of the particles (-).
+    kappa : ndarray (n,)
+        Their largest effective tensile stress so far (Pa).
+    material : TensileCracking
+        Their cracking material (``mu``, ``lam`` in Pa, ``tensile_strength`` in Pa, ``damage(kappa)``).
+    """
+    H = np.asarray(H, dtype=np.float64)
+    F = H + np.eye(H.shape[1])
+    b = np.einsum("nij,nkj->nik", F, F)
+    eps = 0.5 * np.log(np.clip(np.linalg.eigvalsh(b), 1e-300, None))      # principal Hencky strains
+    tau = 2.0 * material.mu * eps + material.lam * eps.sum(axis=1, keepdims=True)
+    kappa = np.asarray(kappa, dtype=np.float64)
+    d = np.asarray(material.damage(kappa), dtype=np.float64).reshape(-1, 1)
+    carried = np.where(tau > 0.0, (1.0 - d) * tau, tau).max(axis=1, initial=-np.inf)
+    ratio = np.maximum(carried, 0.0) / material.tensile_strength
+    return np.where(kappa > material.tensile_strength, np.maximum(ratio, 1.0), ratio)
 
 
 class SlabCrackDetector:
@@ -54,11 +84,16 @@ class SlabCrackDetector:
     params : PSTParams
     groups : list of GroupState
         The slab layers' particle groups (cracking materials).
+    body_above : float, optional
+        Height (m, initial positions) above which a slab particle belongs to the slab's body
+        (:meth:`body_stress_ratio`); default: all of the slab.
     """
 
-    def __init__(self, params: PSTParams, groups):
+    def __init__(self, params: PSTParams, groups, body_above: float = -math.inf):
         self.params = params
         self.groups = groups
+        #: per group, its particles in the slab's body
+        self.body = [np.asarray(g.x0[:, 1]) > body_above for g in groups]
         x0 = np.concatenate([g.x0 for g in groups])
         s = self.s = params.distance_from_cut_end(x0[:, 0])
         w = params.bin_width
@@ -86,18 +121,21 @@ class SlabCrackDetector:
         a crack went through the slab."""
         best = 0.0
         for g in self.groups:
-            m = g.material
-            H = g.H.numpy().astype(np.float64)
-            F = H + np.eye(H.shape[1])
-            b = np.einsum("nij,nkj->nik", F, F)
-            eps = 0.5 * np.log(np.clip(np.linalg.eigvalsh(b), 1e-300, None))      # principal Hencky strains
-            tau = 2.0 * m.mu * eps + m.lam * eps.sum(axis=1, keepdims=True)
-            kappa = g.kappa.numpy().astype(np.float64)
-            d = np.asarray(m.damage(kappa), dtype=np.float64).reshape(-1, 1)
-            carried = np.where(tau > 0.0, (1.0 - d) * tau, tau).max(axis=1, initial=-np.inf)
-            best = max(best, float(np.max(carried, initial=0.0)) / m.tensile_strength)
-            if np.any(kappa > m.tensile_strength):
-                best = max(best, 1.0)
+            r = carried_over_strength(g.H.numpy(), g.kappa.numpy(), g.material)
+            best = max(best, float(np.max(r, initial=0.0)))
+        return best
+
+    def body_stress_ratio(self) -> float:
+        """:meth:`stress_ratio` over the slab's body alone (the particles above ``body_above``), nan without one.
+
+        The slab's rows whose grid stencils share nodes with the weak layer's are pulled by the collapsing layer
+        and crack along the bed, a crack that cannot go through the slab (docs/field.md, "Why the slab's stress
+        read 20-124 times its strength"); the body's stress is the one a crack through the slab starts from."""
+        best = math.nan
+        for g, body in zip(self.groups, self.body, strict=True):
+            if body.any():
+                r = carried_over_strength(g.H.numpy()[body], g.kappa.numpy()[body], g.material)
+                best = max(0.0 if best != best else best, float(r.max()))
         return best
 
     def crack_cover(self) -> float:
