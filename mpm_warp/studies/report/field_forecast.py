@@ -44,15 +44,41 @@ def render_mechanisms(data: dict, ctx) -> list[str]:
             f"balanced accuracy {fx(r['balanced_accuracy'], 2)}, recall END {fx(r['recall']['END'], 2)}, SF "
             f"{fx(r['recall']['SF'], 2)}, ARR {fx(r['recall']['ARR'], 2)} on these {r['n']} columns.",
             *_bar_line(data.get("information_bar")),
-            f"- **The run's own slab** (`run_slab_crack_ratio`, its largest effective stress over strength) "
-            f"scores {fx(c['run_slab_crack_ratio']['sf_vs_end']['auc'], 3)}, and weac's static stress at the "
-            f"recorded cut {fx(c['static_peak_ratio']['sf_vs_end']['auc'], 3)}: neither tells the SF records from the "
-            "END records much better than chance; the touchdown distance, where the slab beyond the cut lands on "
-            "its collapsed weak layer, does.",
+            *_run_line(c),
             f"- **Brittleness** runs the other way ({fx(c['brittleness']['sf_vs_end']['auc'], 3)}): thin, light "
             "slabs are the least brittle by this measure (the shortest depth for their characteristic length), so "
             "brittleness does not explain why they break.", "", env_note(data)]
     return out
+
+
+#: what the model's probability read, by the key each case names (``slab_reading``; none in an older file)
+READINGS = {"slab_peak_body_stress_ratio": "the slab body's peak stress over the run",
+            "slab_body_stress_ratio_at_call": "the slab body's stress at the call, from the run's final checkpoint",
+            "slab_peak_stress_ratio": "the whole slab's peak stress over the run"}
+
+
+def _reading(data: dict) -> str:
+    """What the model's probabilities read, with how many cases read each where they differ."""
+    keys = [c.get("slab_reading", "slab_peak_stress_ratio") for c in data.get("cases", [])]
+    counts = {k: keys.count(k) for k in READINGS if k in keys}
+    if len(counts) <= 1:
+        return READINGS[next(iter(counts), "slab_peak_stress_ratio")]
+    return "; ".join(f"{READINGS[k]} ({n} cases)" for k, n in counts.items())
+
+
+def _run_line(c: dict) -> list[str]:
+    """The run's own readings (``run_*``) against weac's static stress at the recorded cut."""
+    runs = {k: v["sf_vs_end"]["auc"] for k, v in c.items()
+            if k.startswith("run_") and v["sf_vs_end"]["auc"] is not None}
+    if not runs:
+        return []
+    best = max(runs, key=runs.get)
+    listed = ", ".join(f"`{k}` {fx(a, 3)}" for k, a in runs.items())
+    td = c["touchdown_distance"]["sf_vs_end"]["auc"]
+    verdict = ("above" if runs[best] > td else "below")
+    return [f"- **The run's own readings** (SF against END): {listed}; weac's static stress at the recorded cut "
+            f"{fx(c['static_peak_ratio']['sf_vs_end']['auc'], 3)}. The best of the run's, `{best}`, lies {verdict} "
+            f"Heierli's touchdown distance ({fx(td, 3)}), the closed form of where the slab lands beyond the cut."]
 
 
 def _bar_line(bar: dict | None) -> list[str]:
@@ -89,8 +115,8 @@ def render_forecast(data: dict, ctx) -> list[str]:
     drawn = sum(sel.get(k, 0) for k in FIELD_CLASSES)
     out = [f"The first {sc['cases']} finished cases of the stratified draw ({drawn} drawn, {sel.get('per_class')} a "
            f"class, seed {sel.get('seed')}), interleaved by class. The model: one run a case, read at first order "
-           "(its slab's peak stress under snow's Weibull strength scatter, docs/field.md). Intervals: 95 %, paired "
-           "bootstrap within each class.", ""]
+           f"({_reading(data)} under snow's Weibull strength scatter, docs/field.md). Intervals: 95 %, "
+           "paired bootstrap within each class.", ""]
     out += table(["forecast", "RPS", "RPSS (vs climatology)", "Brier END / SF / ARR", "AUC SF", "AUC ARR",
                   "balanced accuracy (most probable)"], rows)
     for name, why in sc.get("forecast_missing", {}).items():
