@@ -43,9 +43,7 @@ def open_writer(sim, path: str) -> io.RunWriter:
     for i, g in enumerate(model.groups):
         group_id[g.start:g.end] = i
     static = {"x0": (sim.x0.astype(model.np_dtype), "m"), "group": (group_id, "1")}
-    scalars = {"kinetic_energy": "J", "elastic_energy": "J"}
-    for m in sim.monitors.values():
-        scalars.update(m.units())
+    scalars = series_units(sim)
     attrs = {
         "scenario": sc.to_dict(),
         "versions": versions(),
@@ -136,9 +134,20 @@ def frame_record(sim) -> tuple[float, int, dict, np.ndarray | None, dict]:
     return t, steps, parts, forces, scalars
 
 
-def write_frame(sim, writer: io.RunWriter) -> None:
-    """Append the frame ``sim`` is at to ``writer``."""
+def series_units(sim) -> dict[str, str]:
+    """The frame series ``sim`` records, name -> unit: the energies, then each monitor's."""
+    scalars = {"kinetic_energy": "J", "elastic_energy": "J"}
+    for m in sim.monitors.values():
+        scalars.update(m.units())
+    return scalars
+
+
+def write_frame(sim, writer: io.RunWriter, left_out: frozenset = frozenset()) -> None:
+    """Append the frame ``sim`` is at to ``writer``, less the series ``left_out`` (those a resumed run's file,
+    written by an older release, does not hold)."""
     t, steps, parts, forces, scalars = frame_record(sim)
+    for name in left_out:
+        scalars.pop(name, None)
     writer.write_frame(t, steps, parts, wall_forces=forces, scalars=scalars)
 
 

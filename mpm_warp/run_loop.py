@@ -80,6 +80,8 @@ class FrameRun:
     def __init__(self, sim, output, end: float, fi: float, callback, append: bool):
         self.sim, self.output, self.end, self.fi, self.callback, self.append = sim, output, end, fi, callback, append
         self.writer = None
+        #: series the monitors record that a resumed run file (an older release's) does not hold
+        self.left_out: frozenset = frozenset()
         self.ckpt = io.checkpoint_path_for(output) if output else None
         self.n_frames_total = int(math.ceil(end / fi - 1e-9))
         self.steps_total, self.n_done, self.wall, self.stopped = 0, 0, 0.0, False
@@ -103,6 +105,11 @@ class FrameRun:
             if self.append:
                 # every frame is kept (restore() read them all): those after the checkpoint are stepped over
                 self.writer = io.RunWriter.reopen(output, verify=False)
+                self.left_out = frozenset(frames.series_units(sim)) - frozenset(self.writer.scalar_series)
+                if self.left_out:
+                    logging.getLogger("mpm_warp").warning(
+                        f"{output}: written by an older release without the series {sorted(self.left_out)}; the "
+                        "resumed run records the series the file holds")
             else:
                 sim.run_id = frames.new_run_id()
                 self.writer = frames.open_writer(sim, output)
@@ -135,7 +142,7 @@ class FrameRun:
             if sim.frame_index < writer.n_frames:   # on file already (after the checkpoint): kept
                 frames.frame_record(sim)
             else:
-                frames.write_frame(sim, writer)
+                frames.write_frame(sim, writer, self.left_out)
             ce = sim.scenario.output.checkpoint_every
             if ce and sim.frame_index % ce == 0:
                 _checkpoint(sim, self.ckpt)

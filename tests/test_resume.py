@@ -42,6 +42,24 @@ def test_resumed_run_matches_uninterrupted_bit_for_bit(tmp_path):
     assert res.sim_time == a.times[-1]
 
 
+def test_a_run_file_without_a_series_of_this_release_resumes_without_it_and_says_so(tmp_path, caplog):
+    """A file written before a monitor gained a series (here: its ``elastic_energy`` taken out) resumes: the
+    series it holds go on, every frame kept, the new one is left out in one logged line."""
+    import h5py
+
+    part = tmp_path / "old.h5"
+    sc = mw.load_scenario("elastic_block", TINY)
+    mw.Simulation(sc, device=DEVICE).run(str(part), callback=lambda sim, k: k < 3)
+    with h5py.File(part, "r+") as f:
+        del f["scalars/elastic_energy"]
+    with caplog.at_level("WARNING", logger="mpm_warp"):
+        mw.resume(str(part), device=DEVICE)
+    lines = [r.getMessage() for r in caplog.records if "older release" in r.getMessage()]
+    assert len(lines) == 1 and "['elastic_energy']" in lines[0] and str(part) in lines[0]
+    run = mw.read_run(str(part))
+    assert run.n_frames == 7 and set(run.scalars) == {"kinetic_energy"} and len(run.scalars["kinetic_energy"]) == 7
+
+
 def test_checkpoint_holds_the_full_state(tmp_path):
     path = tmp_path / "run.h5"
     _run(path)

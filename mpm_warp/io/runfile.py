@@ -232,6 +232,11 @@ class RunWriter:
             raise err from None
 
     @property
+    def scalar_series(self) -> dict[str, str]:
+        """The declared scalar series, name -> unit."""
+        return dict(self._scalars)
+
+    @property
     def n_frames(self) -> int:
         """Number of complete frames in the file."""
         return self._n
