@@ -265,3 +265,24 @@ def test_a_brittle_slab_over_a_thick_weak_layer_gets_the_grid_its_crack_band_nee
     assert p.dx < p.weak_layer_thickness / 4 and p.crack_band == pytest.approx(0.99 * limit)
     scenario, note = case_scenario(case, FieldProtocol())
     assert scenario is not None and note.startswith("4.3 cells across the weak layer, as the slab's crack band needs")
+
+
+def test_a_run_of_another_selection_is_found_once_under_its_own_position(tmp_path, monkeypatch):
+    """A case numbered k=3 in a batch of one selection is the same case at k=1 in another (same pit, same key):
+    it is taken from there, each file once, so two identical records of a pit stay two cases; another pit's file
+    with the same key, or the same pit's with another key, is not taken."""
+    from mpm_warp.field import batch
+
+    def finished(out):
+        return {"id": os.path.basename(out), "status": "ok"} if os.path.exists(out + ".json") else None
+
+    monkeypatch.setattr(batch.io, "finished_record", finished)
+    for name in ("pit-a-3-0123456789ab", "pit-a-5-0123456789ab", "pit-a-9-fedcba987654", "pit-a-b-7-0123456789ab"):
+        (tmp_path / f"{name}.json").write_text("{}")
+    task = {"out_dir": str(tmp_path), "id": "pit-a-1-0123456789ab"}
+    claimed = set()
+    assert batch._finished(task, claimed)["id"] == "pit-a-3-0123456789ab"
+    assert batch._finished({**task, "id": "pit-a-2-0123456789ab"}, claimed)["id"] == "pit-a-5-0123456789ab"
+    assert batch._finished({**task, "id": "pit-a-4-0123456789ab"}, claimed) is None      # both taken
+    assert batch._finished({**task, "id": "pit-a-5-0123456789ab"}, set())["id"] == "pit-a-5-0123456789ab"
+    assert batch._finished({**task, "id": "pit-c-1-0123456789ab"}, set()) is None       # another pit

@@ -103,18 +103,35 @@ def _write_json(path: str, obj: dict) -> None:
     write_case_record(path, obj)
 
 
-def _finished(task: dict) -> dict | None:
+def _finished(task: dict, claimed: set | None = None) -> dict | None:
     """The task's record from an earlier batch when it finished; None (run it again) where its file says otherwise,
-    whatever it holds (``[]``, a truncated file)."""
-    return io.finished_record(os.path.join(task["out_dir"], task["id"]))
+    whatever it holds (``[]``, a truncated file).
+
+    A batch of another selection (the measured-density columns with the stratified draw, or without) numbers the
+    same case differently: where the task's own file has no finished run, a finished run of the same pit and key
+    under another position is taken, each at most once in a batch (``claimed``: the ids taken so far), so that two
+    identical records of one pit stay two cases."""
+    claimed = set() if claimed is None else claimed
+    own = task["id"]
+    stem, _, digest = own.rsplit("-", 2)
+    pattern = os.path.join(glob.escape(task["out_dir"]), f"{glob.escape(stem)}-*-{digest}.json")
+    candidates = [own] + sorted(os.path.basename(p)[:-5] for p in glob.glob(pattern))
+    for cid in candidates:
+        if cid in claimed or cid.rsplit("-", 2)[0] != stem:
+            continue
+        rec = io.finished_record(os.path.join(task["out_dir"], cid))
+        if rec is not None:
+            claimed.add(cid)
+            return rec
+    return None
 
 
 def finished_records(cases: list, out_dir: str, protocol: FieldProtocol | None = None) -> list[dict]:
     """The records of ``cases`` (in order; :func:`run_cases`'s list) whose runs in ``out_dir`` under ``protocol``
     (default :class:`~.protocol.FieldProtocol`) have finished: what a batch stopped early has measured, scored
     without running or building anything."""
-    proto = protocol or FieldProtocol()
-    recs = (_finished({"out_dir": out_dir, "id": _case_id(c, k, proto)}) for k, c in enumerate(cases))
+    proto, claimed = protocol or FieldProtocol(), set()
+    recs = (_finished({"out_dir": out_dir, "id": _case_id(c, k, proto)}, claimed) for k, c in enumerate(cases))
     return [r for r in recs if r is not None]
 
 
@@ -322,14 +339,14 @@ def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None =
 def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Progress, verbose) -> FieldBatch:
     """Run the tasks of the iterator ``tasks`` not finished in ``out_dir`` before, as they are set up; write the
     records, the refusals and the scores."""
-    done, ran, records = [], [], {}
+    done, ran, records, claimed = [], [], {}, set()
 
     def todo():
         for t in tasks:
             done.append(t)
             progress.tasks = len(done)
             progress.refused = len(refused)
-            records[t["id"]] = _finished(t)
+            records[t["id"]] = _finished(t, claimed)
             if records[t["id"]] is None:
                 ran.append(t)
                 yield t
