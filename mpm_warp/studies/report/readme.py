@@ -124,9 +124,13 @@ def _field(ctx: Context) -> str | None:
 def _outcomes(ctx: Context) -> str | None:
     """The field outcomes against the observers: the model's balanced accuracy beside both baselines'."""
     data = ctx.load("field/results/field_batch.json")
-    if data is None or data["selection"].get("finished_only"):
+    if data is None:
         return None
     sc = data["scores"]
+    sel = data["selection"]
+    drawn = sum(sel.get(k, 0) for k in ("END", "SF", "ARR"))
+    stopped = (f" (a batch stopped early: the {sc['cases']:,} finished of {drawn:,} drawn, not yet a verdict)"
+               if sel.get("finished_only") else "")
     iv = (sc.get("uncertainty") or {}).get("intervals") or {}
 
     def ba(key: str) -> str:
@@ -136,10 +140,11 @@ def _outcomes(ctx: Context) -> str | None:
     rec = sc["model"]["recall"]
     m = sc["model"]["balanced_accuracy"]
     above = all(m > sc[k]["balanced_accuracy"] for k in ("majority", "weac_static"))
-    return (f"- **Field outcomes:** on {sc['cases']:,} real PSTs drawn by observed class, the model's END/SF/ARR "
-            f"balanced accuracy is {ba('model')}, against {ba('majority')} for always answering one class and "
-            f"{ba('weac_static')} for a static rule from weac's slab stress: "
-            f"{'above both' if above else 'not above both'}. Its recall: END {rec['END']:.0%}, SF {rec['SF']:.0%}, "
+    verdict = "not judged on part of the draw" if stopped else "above both" if above else "not above both"
+    return (f"- **Field outcomes:** on {sc['cases']:,} real PSTs drawn by observed class{stopped}, the model's "
+            f"END/SF/ARR balanced accuracy is {ba('model')}, against {ba('majority')} for always answering one class "
+            f"and {ba('weac_static')} for a static rule from weac's slab stress: "
+            f"{verdict}. Its recall: END {rec['END']:.0%}, SF {rec['SF']:.0%}, "
             f"ARR {rec['ARR']:.0%} ([Field outcomes against the observers]"
             f"({_link('Field outcomes against the observers')})).")
 
