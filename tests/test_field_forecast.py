@@ -174,11 +174,12 @@ def test_the_committed_batches_rescore_to_their_committed_scores(path):
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     with open(os.path.join(root, path)) as fh:
         data = json.load(fh)
-    again = json.loads(json.dumps(score_records(data["cases"], resamples=200)))
+    again = json.loads(json.dumps(score_records(data["cases"])))
     for key, value in data["scores"].items():
         assert again[key] == value, key
     assert again["cases"] == len([c for c in data["cases"] if c["status"] == "ok"])
-    assert set(again["forecast_missing"]) == {"model", "information_bar"}   # records from before both readings
+    # the cases carry what every forecast reads: the slab's reading and the information bar's numbers
+    assert again["forecast_missing"] == {} and set(again["forecast"]) >= {"model", "information_bar"}
 
 
 def test_the_run_summary_line_of_the_probabilities():

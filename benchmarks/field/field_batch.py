@@ -25,6 +25,7 @@ from mpm_warp.field.batch import FieldBatch, finished_records, gather, run_cases
 from mpm_warp.field.draw import select
 from mpm_warp.field.information_bar import CASE_FEATURES
 from mpm_warp.field.protocol import FieldProtocol
+from mpm_warp.field.studies.at_call import body_at_call
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -34,8 +35,8 @@ RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 #: each case's keys in the JSON
 CASE_KEYS = ("id", "pit", "test", "observed", "predicted", "p_end", "p_sf", "p_arr", "static_class",
              "static_peak_ratio", "recorded_cut", "runaway_cut", "slab_fracture_at", "slab_peak_stress_ratio",
-             *CASE_FEATURES, "w_f", "w_f_source", "setup", "particles", "steps", "threads", "workers", "wall_s",
-             "status", "error")
+             "slab_peak_body_stress_ratio", "slab_body_stress_ratio_at_call", *CASE_FEATURES, "w_f", "w_f_source",
+             "setup", "particles", "steps", "threads", "workers", "wall_s", "status", "error")
 
 
 def main(argv=None) -> int:
@@ -74,6 +75,7 @@ def main(argv=None) -> int:
                           pre_cut_share=args.pre_cut_share, interface_closure=args.interface_closure).validate()
     if args.finished_only:
         recs = finished_records(chosen, runs, proto)
+        body_at_call(recs, runs)                 # runs from before the body's series: its stress at the call
         batch = FieldBatch(recs, [], score_records(recs), len(recs), runs)
     else:
         batch = run_cases(chosen, [], runs, workers=args.workers, device=args.device,

@@ -27,6 +27,7 @@ from mpm_warp.field.draw import finished_draw
 from mpm_warp.field.probability import slab_reading
 from mpm_warp.field.scores import FIELD_CLASSES
 from mpm_warp.field.scoring import forecasts, score_records, scored
+from mpm_warp.field.studies.at_call import body_at_call
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
@@ -59,17 +60,6 @@ def reliability_figure(sc: dict, path: str) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
-
-
-def body_at_call(recs: list[dict], runs: str) -> None:
-    """Give each finished record without the body's series its slab body's stress at the call, from its final
-    checkpoint (``slab_body_stress_ratio_at_call``; the reading the model's probability takes then)."""
-    from mpm_warp.field.run_on import scenario_of
-    from mpm_warp.field.studies.at_call import body_stress_ratio
-
-    for r in scored(recs):
-        if r.get("slab_peak_body_stress_ratio") is None:
-            r["slab_body_stress_ratio_at_call"] = body_stress_ratio(runs, r["id"], scenario_of(runs, r["id"]))
 
 
 def made_up(n: int = 30, seed: int = 0) -> list[dict]:

@@ -21,7 +21,7 @@ import numpy as np
 
 from ...scenes.pst.outcome import TIE_CELLS
 
-__all__ = ["AT_CALL_KEYS", "readings_at_call", "body_stress_ratio", "case_readings"]
+__all__ = ["AT_CALL_KEYS", "readings_at_call", "body_stress_ratio", "case_readings", "body_at_call"]
 
 #: the readings :func:`readings_at_call` returns, each with what it is
 AT_CALL_KEYS = {
@@ -130,3 +130,19 @@ def case_readings(run_dir: str, case_id: str, scenario) -> dict:
     out = readings_at_call(series, stored_calibration(scenario).h_c)
     out["slab_body_stress_ratio_at_call"] = body_stress_ratio(run_dir, case_id, scenario)
     return out
+
+
+def body_at_call(recs: list[dict], runs: str) -> None:
+    """Give each finished record of ``recs`` (runs folder ``runs``) without the body's series its slab body's stress
+    at the call, from its final checkpoint (``slab_body_stress_ratio_at_call``, the reading the model's probability
+    then takes: :func:`mpm_warp.field.probability.slab_reading`), and its probabilities (``p_end``, ``p_sf``,
+    ``p_arr``) from it."""
+    from ..probability import outcome_probability, slab_reading
+    from ..run_on import scenario_of
+
+    for r in recs:
+        if r.get("status") == "ok" and r.get("slab_peak_body_stress_ratio") is None:
+            r["slab_body_stress_ratio_at_call"] = body_stress_ratio(runs, r["id"], scenario_of(runs, r["id"]))
+            prob = outcome_probability(r.get("predicted"), slab_reading(r)[0])
+            if prob is not None:
+                r["p_end"], r["p_sf"], r["p_arr"] = prob
