@@ -39,6 +39,7 @@ from . import (  # noqa: F401
     field,
     field_closure,
     field_columns,
+    field_equivalent,
     field_far_end,
     field_forecast,
     field_plane_stress,
