@@ -124,7 +124,8 @@ def test_the_slab_stress_ratio_is_the_stress_the_slab_carries():
         """``parts``: (principal Hencky strains (e1, e2), kappa Pa), each particle stretched in a rotated frame."""
         H = np.array([R @ np.diag(np.exp(e)) @ R.T - np.eye(2) for e, _ in parts])
         g = SimpleNamespace(material=mat, H=_Host(H), kappa=_Host([k for _, k in parts]))
-        return SlabCrackDetector.stress_ratio(SimpleNamespace(groups=[g]))
+        det = SimpleNamespace(groups=[g], body=[np.zeros(len(parts), dtype=bool)])
+        return SlabCrackDetector.stress_ratios(det)[0]
 
     # intact: tau_1 = 6 MPa x 1e-4 = 600 Pa = 0.12 of the strength; a squeezed particle carries no tension
     assert ratio(((1e-4, 0.0), 0.0)) == pytest.approx(0.12, rel=1e-6)

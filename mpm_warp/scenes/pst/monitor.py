@@ -128,8 +128,7 @@ class PSTMonitor(ReferenceField, SeriesMonitor):
                "deflection_front": deflection, "saw": self.saw_position(t)}
         if self.slab_crack is not None:
             out["slab_crack"] = self.slab_crack.through_crack()
-            out["slab_stress_ratio"] = self.slab_crack.stress_ratio()
-            out["slab_body_stress_ratio"] = self.slab_crack.body_stress_ratio()
+            out["slab_stress_ratio"], out["slab_body_stress_ratio"] = self.slab_crack.stress_ratios()
             out["slab_crack_cover"] = self.slab_crack.crack_cover()
         c, sawn = self.weak.collapse()
         gone = (self.weak.bond() <= 0.0) & (sawn == 0) & self.interior

@@ -119,11 +119,7 @@ class SlabCrackDetector:
         ``kappa``, grow without bound as a crack opens: they say how far a crack opened, not what the slab carries
         (docs/field.md, "Why the slab's stress read 20-124 times its strength"); :meth:`crack_cover` says how far
         a crack went through the slab."""
-        best = 0.0
-        for g in self.groups:
-            r = carried_over_strength(g.H.numpy(), g.kappa.numpy(), g.material)
-            best = max(best, float(np.max(r, initial=0.0)))
-        return best
+        return self.stress_ratios()[0]
 
     def body_stress_ratio(self) -> float:
         """:meth:`stress_ratio` over the slab's body alone (the particles above ``body_above``), nan without one.
@@ -131,12 +127,17 @@ class SlabCrackDetector:
         The slab's rows whose grid stencils share nodes with the weak layer's are pulled by the collapsing layer
         and crack along the bed, a crack that cannot go through the slab (docs/field.md, "Why the slab's stress
         read 20-124 times its strength"); the body's stress is the one a crack through the slab starts from."""
-        best = math.nan
-        for g, body in zip(self.groups, self.body, strict=True):
-            if body.any():
-                r = carried_over_strength(g.H.numpy()[body], g.kappa.numpy()[body], g.material)
-                best = max(0.0 if best != best else best, float(r.max()))
-        return best
+        return self.stress_ratios()[1]
+
+    def stress_ratios(self) -> tuple[float, float]:
+        """``(whole, body)``: :meth:`stress_ratio` and :meth:`body_stress_ratio` from one read of the particles."""
+        whole, body = 0.0, math.nan
+        for g, in_body in zip(self.groups, self.body, strict=True):
+            r = carried_over_strength(g.H.numpy(), g.kappa.numpy(), g.material)
+            whole = max(whole, float(np.max(r, initial=0.0)))
+            if in_body.any():
+                body = max(0.0 if body != body else body, float(r[in_body].max()))
+        return whole, body
 
     def crack_cover(self) -> float:
         """The largest share of the slab's particle rows (-) that fully damaged particles (damage >=
