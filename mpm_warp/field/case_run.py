@@ -15,7 +15,7 @@ import traceback
 
 from .. import io
 from .information_bar import CASE_FEATURES
-from .probability import outcome_probability, slab_reading
+from .probability import record_probabilities
 from .protocol import decided, run_to_decision
 
 __all__ = ["run_case", "run_case_group", "write_case_record", "column_step"]
@@ -59,9 +59,7 @@ def _finish(rec: dict, task: dict, res, threads) -> None:
                slab_peak_body_stress_ratio=_finite(o.get("slab_peak_body_stress_ratio")),
                sim_time=res.sim_time, steps=res.steps, particles=res.n_particles, wall_s=res.wall_time,
                threads=threads, workers=task.get("workers"), n_frames=io.read_run(out + ".part.h5").n_frames)
-    prob = outcome_probability(rec["predicted"], slab_reading(rec)[0])
-    if prob is not None:
-        rec["p_end"], rec["p_sf"], rec["p_arr"] = prob
+    record_probabilities(rec)
     io.promote_part(out)
     rec["run_file"] = os.path.basename(out + ".h5")
 

@@ -19,7 +19,7 @@ import math
 from ..scenes.pst.outcome import CLASSES
 
 __all__ = ["WEIBULL_MODULUS", "SLAB_READINGS", "weibull_break_probability", "slab_reading", "outcome_probability",
-           "probability_line"]
+           "record_probabilities", "probability_line"]
 
 #: Weibull modulus of snow's tensile strength (-), Phys. Rev. E 69, 011306 (2004)
 WEIBULL_MODULUS = 1.5
@@ -59,6 +59,14 @@ def outcome_probability(predicted: str | None, slab_peak_stress_ratio: float | N
     if predicted in ("ARR", "NP"):
         return 0.0, p_sf, 1.0 - p_sf
     return 1.0 - p_sf, p_sf, 0.0
+
+
+def record_probabilities(rec: dict) -> None:
+    """Set a field record's ``p_end``, ``p_sf``, ``p_arr`` from its ``predicted`` class and its slab's reading
+    (:func:`slab_reading`); a record without a probability is left as it is."""
+    prob = outcome_probability(rec.get("predicted"), slab_reading(rec)[0])
+    if prob is not None:
+        rec["p_end"], rec["p_sf"], rec["p_arr"] = prob
 
 
 def probability_line(outcome: dict) -> str:

@@ -137,12 +137,10 @@ def body_at_call(recs: list[dict], runs: str) -> None:
     at the call, from its final checkpoint (``slab_body_stress_ratio_at_call``, the reading the model's probability
     then takes: :func:`mpm_warp.field.probability.slab_reading`), and its probabilities (``p_end``, ``p_sf``,
     ``p_arr``) from it."""
-    from ..probability import outcome_probability, slab_reading
+    from ..probability import record_probabilities
     from ..run_on import scenario_of
 
     for r in recs:
         if r.get("status") == "ok" and r.get("slab_peak_body_stress_ratio") is None:
             r["slab_body_stress_ratio_at_call"] = body_stress_ratio(runs, r["id"], scenario_of(runs, r["id"]))
-            prob = outcome_probability(r.get("predicted"), slab_reading(r)[0])
-            if prob is not None:
-                r["p_end"], r["p_sf"], r["p_arr"] = prob
+            record_probabilities(r)
