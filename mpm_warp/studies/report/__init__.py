@@ -37,6 +37,7 @@ from ...markers import checkout_root, generator_args, write_generated
 from . import (  # noqa: F401
     convergence,
     field,
+    field_arrest,
     field_closure,
     field_columns,
     field_equivalent,
