@@ -58,3 +58,19 @@ def test_a_read_back_column_starts_at_its_cut_and_the_frame_scale_scatter_cannot
     assert fine["p_arr"][0.3] > 0.05
     # a fracture energy above G everywhere: no propagation, said in one line
     assert A.column_arrest(p, 1e6, cut)["why"].startswith("no propagation")
+
+
+@pytest.mark.skipif(wr.weac_unavailable() is not None, reason="weac 2.6 is not installed")
+def test_a_cut_where_weac_finds_no_touchdown_takes_the_free_slabs_g(monkeypatch):
+    p = pst.PSTParams(length=1.0, weak_layer_thickness=0.03, slope_angle=30.0, column_ends="vertical")
+    col, free = static_column(p), wr.energy_release_rate
+
+    def no_touchdown(column, cut, touchdown=False):
+        if touchdown:
+            raise ValueError("f(a) and f(b) must have different signs")      # weac's calc_lC, as seen in the field
+        return free(column, cut)
+
+    monkeypatch.setattr(wr, "energy_release_rate", no_touchdown)
+    x, g, unsolved = A.release_profile(col, 1.0, 0.3)
+    assert unsolved == A.PROFILE_POINTS
+    assert g[0] == pytest.approx(free(col, 0.3 + A.GRID_M)[0], rel=0.05)   # log-interpolated between solved cuts

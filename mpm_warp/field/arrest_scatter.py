@@ -65,21 +65,28 @@ def arrest_probability(x, g, start: float, xi: float, *, cv: float = STRENGTH_CV
 
 
 def release_profile(column, w_f: float, start: float, *, grid: float = GRID_M, points: int = PROFILE_POINTS,
-                    far_end: float = FAR_END_M) -> tuple[np.ndarray, np.ndarray] | None:
-    """``(x, G/w_f)``: weac's G (the lesser with and without touchdown) over ``w_f`` at the points of
+                    far_end: float = FAR_END_M) -> tuple[np.ndarray, np.ndarray, int] | None:
+    """``(x, G/w_f, n)``: weac's G (the lesser with and without touchdown) over ``w_f`` at the points of
     ``grid`` (m) from ``start`` (exclusive) to ``far_end`` before the end of ``column`` (a
     :class:`~mpm_warp.scenes.pst.static.StaticColumn`), interpolated in log between ``points`` solved cuts that
-    crowd towards the start; None where no point lies between."""
+    crowd towards the start; ``n``: the solved cuts where weac's touchdown has no solution (its root search finds
+    no touchdown length), which take the free slab's G; None where no point lies between."""
     from ..scenes.weac_reference import energy_release_rate
 
     end = column.length - far_end
     if end - start < grid:
         return None
     cuts = start + (end - start) * np.linspace(0.0, 1.0, points) ** 2
-    G = [min(energy_release_rate(column, float(a))[0], energy_release_rate(column, float(a), touchdown=True)[0])
-         for a in cuts]
+    G, untouched = [], 0
+    for a in cuts:
+        free = energy_release_rate(column, float(a))[0]
+        try:
+            G.append(min(free, energy_release_rate(column, float(a), touchdown=True)[0]))
+        except ValueError:                      # weac finds no touchdown length at this cut: the free slab's G
+            G.append(free)
+            untouched += 1
     x = start + grid * np.arange(1, int(math.floor((end - start) / grid)) + 1)
-    return x, np.exp(np.interp(x, cuts, np.log(np.maximum(G, 1e-300) / w_f)))
+    return x, np.exp(np.interp(x, cuts, np.log(np.maximum(G, 1e-300) / w_f))), untouched
 
 
 def column_arrest(params, w_f: float, cut: float, *, xis=CORRELATION_LENGTHS, cv: float = STRENGTH_CV,
@@ -88,8 +95,9 @@ def column_arrest(params, w_f: float, cut: float, *, xis=CORRELATION_LENGTHS, cv
     the recorded ``cut`` (m) where weac's G there reaches ``w_f`` (J/m^2), else at weac's critical cut; the field
     read every ``grid`` (m).
 
-    Returns ``{"start": m, "g_at_10cm": G/w_f 10 cm past the start, "p_arr": {xi: P}}``, or ``{"why": line}``
-    where weac is missing or the crack never starts or has no room to stop."""
+    Returns ``{"start": m, "touchdown_unsolved": n, "g_at_10cm": G/w_f 10 cm past the start, "p_arr": {xi: P}}``
+    (``n``: :func:`release_profile`), or ``{"why": line}`` where weac is missing or the crack never starts or
+    has no room to stop."""
     from ..scenes.pst.static import static_column
     from ..scenes.weac_reference import critical_cut_search, energy_release_rate, weac_unavailable
 
@@ -106,8 +114,9 @@ def column_arrest(params, w_f: float, cut: float, *, xis=CORRELATION_LENGTHS, cv
     prof = release_profile(col, w_f, start, grid=grid)
     if prof is None:
         return {"why": f"the crack starts at {start:.3f} m, within {FAR_END_M + grid:.2f} m of the far end"}
-    x, g = prof
-    return {"start": start, "g_at_10cm": float(energy_release_rate(col, start + 0.1)[0] / w_f)
-            if start + 0.1 < col.length else None,
+    x, g, untouched = prof
+    ahead = start + 0.1
+    return {"start": start, "touchdown_unsolved": untouched,
+            "g_at_10cm": float(energy_release_rate(col, ahead)[0] / w_f) if ahead < col.length else None,
             "p_arr": {float(xi): arrest_probability(x, g, start, xi, cv=cv, samples=samples, seed=seed)
                       for xi in xis}}
