@@ -80,6 +80,8 @@ def main(argv=None) -> int:
     else:
         batch = run_cases(chosen, [], runs, workers=args.workers, device=args.device,
                           protocol=proto, progress=True)
+        body_at_call(batch.records, runs)        # reused runs from before the body's series: the same reading
+        batch = FieldBatch(batch.records, batch.refused, score_records(batch.records), batch.skipped, batch.out_dir)
     wall = time.perf_counter() - t1
     ok = [r for r in batch.records if r.get("status") == "ok"]
     data = {"name": "field_batch", "data": os.path.basename(os.path.normpath(args.data)), "environment": env,

@@ -10,9 +10,9 @@ Ranked probability skill against the climatology, Brier score per class, one-vs-
 balanced accuracy of the most probable class, each with paired bootstrap intervals; and the reliability
 diagram. Writes ``benchmarks/field/results/field_forecast.json`` and ``field_forecast.png``.
 
-Usage: ``python benchmarks/field/forecast.py DIR --runs RUNDIR [--per-class 50] [--seed 0]`` (the same draw as
-``field_batch.py``: its first cases, in its interleaved order, whose runs have finished); ``--quick``: a small
-made-up set, no runs.
+Usage: ``python benchmarks/field/forecast.py DIR --runs RUNDIR [--per-class 50] [--seed 0] [--no-measured]``
+(the same draw as ``field_batch.py``: its first cases, in its interleaved order, whose runs have finished);
+``--quick``: a small made-up set, no runs.
 """
 
 from __future__ import annotations
@@ -81,6 +81,8 @@ def main(argv=None) -> int:
     p.add_argument("--runs", help="folder of the batch's runs (field_batch.py --runs)")
     p.add_argument("--per-class", type=int, default=50, help="the batch's sampled cases per class (default 50)")
     p.add_argument("--seed", type=int, default=0, help="the batch's seed (default 0)")
+    p.add_argument("--no-measured", action="store_true",
+                   help="the batch's draw without the measured-density columns (field_batch.py --no-measured)")
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
     if args.quick:
@@ -88,7 +90,8 @@ def main(argv=None) -> int:
     else:
         if not (args.data and args.runs):
             p.error("DIR and --runs are needed without --quick")
-        recs, selection = finished_draw(args.data, args.runs, args.per_class, args.seed)
+        recs, selection = finished_draw(args.data, args.runs, args.per_class, args.seed,
+                                        measured=not args.no_measured)
         body_at_call(recs, args.runs)
     ok = scored(recs)
     made = forecasts(ok)

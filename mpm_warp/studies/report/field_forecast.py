@@ -94,7 +94,8 @@ def _bar_line(bar: dict | None) -> list[str]:
 
 @section("field", "The outcome as a probability: forecast scores", "field/results/field_forecast.json",
          lambda d: (f"python benchmarks/field/forecast.py DIR --runs RUNDIR --per-class "
-                    f"{d['selection'].get('per_class')} --seed {d['selection'].get('seed')}"),
+                    f"{d['selection'].get('per_class')} --seed {d['selection'].get('seed')}"
+                    + (" --no-measured" if not d["selection"].get("measured") else "")),
          figure="field/results/field_forecast.png",
          question="Scored as forecasters score, does the model's probability of END, SF and ARR beat the set's "
                   "climatology, weac's static rule and what the records alone carry?",
