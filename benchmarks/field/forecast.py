@@ -32,6 +32,8 @@ from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+#: points: where each forecast's bin counts sit against its markers, so that forecasts sharing a bin stay legible
+LABEL_OFFSETS = ((4, 4), (4, -11), (-16, 4), (-16, -11))
 
 
 def reliability_figure(sc: dict, path: str) -> None:
@@ -45,14 +47,15 @@ def reliability_figure(sc: dict, path: str) -> None:
     fig, axes = plt.subplots(1, 3, figsize=(12, 4.2), sharey=True)
     for ax, cls in zip(axes, FIELD_CLASSES, strict=True):
         ax.plot([0, 1], [0, 1], color="0.6", lw=1, ls="--", label="perfectly reliable")
-        for name in names:
+        for k, name in enumerate(names):
             t = sc["forecast"][name]["reliability"][cls]
             pts = [(f, o, n) for f, o, n in zip(t["forecast"], t["observed"], t["count"], strict=True) if n]
             if pts:
                 f, o, n = map(np.array, zip(*pts, strict=True))
-                ax.plot(f, o, marker="o", label=f"{name} (RPSS {sc['forecast'][name]['rpss']:+.2f})")
-                for fx, ox, nx in pts:
-                    ax.annotate(str(nx), (fx, ox), textcoords="offset points", xytext=(3, 3), fontsize=7)
+                (line,) = ax.plot(f, o, marker="o", label=f"{name} (RPSS {sc['forecast'][name]['rpss']:+.2f})")
+                for fx, ox, nx in pts:         # each forecast's counts in its colour, on its own side of the point
+                    ax.annotate(str(nx), (fx, ox), textcoords="offset points", xytext=LABEL_OFFSETS[k % 4],
+                                fontsize=7, color=line.get_color())
         ax.set(title=f"{cls}", xlabel=f"forecast P({cls})", xlim=(-0.03, 1.03), ylim=(-0.03, 1.03))
     axes[0].set_ylabel("observed frequency (numbers: cases in the bin)")
     axes[0].legend(fontsize=7, loc="upper left")

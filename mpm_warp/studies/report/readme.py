@@ -141,7 +141,9 @@ def _outcomes(ctx: Context) -> str | None:
     m = sc["model"]["balanced_accuracy"]
     above = all(m > sc[k]["balanced_accuracy"] for k in ("majority", "weac_static"))
     verdict = "not judged on part of the draw" if stopped else "above both" if above else "not above both"
-    return (f"- **Field outcomes:** on {sc['cases']:,} real PSTs drawn by observed class{stopped}, the model's "
+    how = ("the columns with measured slab densities and a draw by observed class" if sel.get("measured")
+           else "drawn by observed class")
+    return (f"- **Field outcomes:** on {sc['cases']:,} real PSTs, {how}{stopped}, the model's "
             f"END/SF/ARR balanced accuracy is {ba('model')}, against {ba('majority')} for always answering one class "
             f"and {ba('weac_static')} for a static rule from weac's slab stress: "
             f"{verdict}. Its recall: END {rec['END']:.0%}, SF {rec['SF']:.0%}, "
