@@ -27,7 +27,7 @@ def render_mechanisms(data: dict, ctx) -> list[str]:
     rows = [[f"`{k}`", v["what"], v["direction"], fx(v["sf_vs_end"]["auc"], 3), fx(v["arr_vs_rest"]["auc"], 3),
              " / ".join(fx(v["median"][k2], 3) for k2 in FIELD_CLASSES)] for k, v in c.items()]
     n = data["counts"]
-    out = [f"On the {sum(n.values())} scored columns of the development set's two batches (END {n['END']}, SF "
+    out = [f"On the {sum(n.values())} scored columns of the development set (END {n['END']}, SF "
            f"{n['SF']}, ARR {n['ARR']}; `{data['cases_from']}`), each set up again from its pit. AUC: the chance "
            "that an SF record's value lies further in the candidate's direction than an END record's (0.5: no "
            "skill; below 0.5: the signal runs the other way); ARR against the rest in the same direction.", ""]
@@ -63,7 +63,7 @@ def _reading(data: dict) -> str:
     counts = {k: keys.count(k) for k in READINGS if k in keys}
     if len(counts) <= 1:
         return READINGS[next(iter(counts), "slab_peak_stress_ratio")]
-    return "; ".join(f"{READINGS[k]} ({n} cases)" for k, n in counts.items())
+    return "; ".join(f"{READINGS[k]} ({n} case{'s' if n != 1 else ''})" for k, n in counts.items())
 
 
 def _run_line(c: dict) -> list[str]:
@@ -113,9 +113,11 @@ def render_forecast(data: dict, ctx) -> list[str]:
                      " / ".join(fx(s["brier"][k], 3) for k in FIELD_CLASSES),
                      fx(s["auc"]["SF"], 2) + _iv(i.get("auc_SF")), fx(s["auc"]["ARR"], 2) + _iv(i.get("auc_ARR")),
                      fx(s["balanced_accuracy"], 2) + _iv(i.get("balanced_accuracy"))])
-    drawn = sum(sel.get(k, 0) for k in FIELD_CLASSES)
-    out = [f"The first {sc['cases']} finished cases of the stratified draw ({drawn} drawn, {sel.get('per_class')} a "
-           f"class, seed {sel.get('seed')}), interleaved by class. The model: one run a case, read at first order "
+    drawn = sum(sel.get(k, 0) for k in FIELD_CLASSES) + sel.get("measured", 0)
+    what = (f"the {sel['measured']} columns with measured slab densities and the draw by class, "
+            if sel.get("measured") else "the stratified draw, ")
+    out = [f"The {sc['cases']} finished cases of {what}{drawn} drawn ({sel.get('per_class')} a class, seed "
+           f"{sel.get('seed')}), interleaved by class. The model: one run a case, read at first order "
            f"({_reading(data)} under snow's Weibull strength scatter, docs/field.md). Intervals: 95 %, "
            "paired bootstrap within each class.", ""]
     out += table(["forecast", "RPS", "RPSS (vs climatology)", "Brier END / SF / ARR", "AUC SF", "AUC ARR",
