@@ -90,6 +90,29 @@ def test_touchdown_caps_G_of_a_long_crack():
     assert G == pytest.approx(G_I + G_II, rel=1e-12) and (G_I, G_II) == pytest.approx((2.240, 0.6573), rel=1e-3)
 
 
+def test_touchdown_of_a_vertical_ended_column_is_capped_too():
+    """weac 2.6 leaves a vertical-ended column's touchdown half done (its G grew to 324 J/m^2 at a 1 m cut of a
+    10 m column where the slope-normal one rests at 3.9): on a flat column the two ends are the same column, so
+    their G with touchdown must agree; on a slope the vertical-ended G rests above the slope-normal one by the end
+    wedge's weight, a share that shrinks as the cut grows, far below the free slab's (the rested slab's axial
+    load keeps G_II growing slowly in both)."""
+    from dataclasses import replace
+
+    flat = replace(arr_column(), length=10.0)
+    for a in (0.5, 1.0, 2.0, 4.0):
+        normal = wr.energy_release_rate(flat, a, touchdown=True)
+        assert wr.energy_release_rate(replace(flat, column_ends="vertical"), a, touchdown=True) == pytest.approx(
+            normal, rel=1e-9)
+    steep = replace(flat, slope_angle=30.0, column_ends="vertical")
+    G = [wr.energy_release_rate(steep, a, touchdown=True)[0] for a in (0.3, 2.0, 6.0)]
+    assert G[0] == pytest.approx(wr.energy_release_rate(steep, 0.3)[0], rel=1e-9)    # hangs free: untouched
+    normal = [wr.energy_release_rate(replace(steep, column_ends="slope_normal"), a, touchdown=True)[0]
+              for a in (2.0, 6.0)]
+    excess = [g / n - 1.0 for g, n in zip(G[1:], normal, strict=True)]
+    assert 0.0 < excess[1] < excess[0] < 0.25                  # 0.17 at 2 m, 0.06 at 6 m
+    assert G[2] < 0.01 * wr.energy_release_rate(steep, 6.0)[0]
+
+
 def test_installed_weac_rounds_to_the_values_recorded_from_weac_3_3_1():
     """The installed weac (2.6 here) computes the ladder PST's critical cuts; they round to the values recorded
     from weac 3.3.1 (``WEAC_3_3_1_RECORDED`` of ``benchmarks/snow/weac_static_pst.py``: computed outside this

@@ -58,7 +58,7 @@ def summary(rows: list[dict]) -> dict:
     """Per reading (the rise of G 10 cm past the start, slower: ARR; P(ARR) at each length): medians by observed
     class and the ARR AUCs, over the cases that have it."""
     read = [r for r in rows if "p_arr" in r]
-    readings = {"g_at_10cm": (lambda r: r["g_at_10cm"], -1.0)}
+    readings = {"g_at_10cm": (lambda r: r["g_at_10cm"], -1.0), "g_min": (lambda r: r.get("g_min"), -1.0)}
     readings.update({f"p_arr_{k}": (lambda r, k=k: r["p_arr"][k], 1.0) for k in (read[0]["p_arr"] if read else ())})
     out = {}
     for key, (value, sign) in readings.items():
@@ -106,7 +106,10 @@ def main(argv=None) -> int:
             "strength_cv": STRENGTH_CV, "correlation_lengths_m": list(CORRELATION_LENGTHS), "grid_m": GRID_M,
             "samples": SAMPLES, "counts": {c: sum(r["observed"] == c for r in described) for c in FIELD_CLASSES},
             "without": {r["id"]: r["why"] for r in described if "why" in r},
-            "readings": summary(described), "spacing_check": {"correlation_length_m": SPACING_XI,
+            "readings": summary(described),
+            "static_arrests": {c: sum(r.get("g_min", 2.0) < 1.0 for r in described if r["observed"] == c)
+                               for c in FIELD_CLASSES},
+            "spacing_check": {"correlation_length_m": SPACING_XI,
                                                               "cases": spacing_check(described, args.runs)},
             "cases": described}
     path = write_json("field_arrest_scatter", data, out_dir(args, RESULTS, "field_arrest_scatter"))

@@ -95,9 +95,10 @@ def column_arrest(params, w_f: float, cut: float, *, xis=CORRELATION_LENGTHS, cv
     the recorded ``cut`` (m) where weac's G there reaches ``w_f`` (J/m^2), else at weac's critical cut; the field
     read every ``grid`` (m).
 
-    Returns ``{"start": m, "touchdown_unsolved": n, "g_at_10cm": G/w_f 10 cm past the start, "p_arr": {xi: P}}``
-    (``n``: :func:`release_profile`), or ``{"why": line}`` where weac is missing or the crack never starts or
-    has no room to stop."""
+    Returns ``{"start": m, "touchdown_unsolved": n, "g_at_10cm": G/w_f 10 cm past the start, "g_min": the least
+    G/w_f at the points read, "p_arr": {xi: P}}`` (``n``: :func:`release_profile`; ``g_min`` below 1: weac's
+    static balance with touchdown stops the crack in a uniform layer, Rosendahl et al. 2025), or
+    ``{"why": line}`` where weac is missing or the crack never starts or has no room to stop."""
     from ..scenes.pst.static import static_column
     from ..scenes.weac_reference import critical_cut_search, energy_release_rate, weac_unavailable
 
@@ -116,7 +117,7 @@ def column_arrest(params, w_f: float, cut: float, *, xis=CORRELATION_LENGTHS, cv
         return {"why": f"the crack starts at {start:.3f} m, within {FAR_END_M + grid:.2f} m of the far end"}
     x, g, untouched = prof
     ahead = start + 0.1
-    return {"start": start, "touchdown_unsolved": untouched,
+    return {"start": start, "touchdown_unsolved": untouched, "g_min": float(g.min()),
             "g_at_10cm": float(energy_release_rate(col, ahead)[0] / w_f) if ahead < col.length else None,
             "p_arr": {float(xi): arrest_probability(x, g, start, xi, cv=cv, samples=samples, seed=seed)
                       for xi in xis}}

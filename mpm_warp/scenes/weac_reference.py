@@ -13,7 +13,7 @@ import importlib
 import importlib.metadata as _md
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -219,9 +219,31 @@ def energy_release_rate(column: StaticColumn, cut: float, touchdown: bool = Fals
     tip (weac's ``gdif``), from the weak layer's normal and shear stress there. ``touchdown``: with weac's
     touchdown (the cut slab's end rests on the collapsed layer once it sinks by weac's collapse height, and
     then lies on it; Rosendahl et al. 2025): the G of a crack long past the critical cut, capped.
+
+    weac 2.6 applies touchdown to columns with slope-normal ends only: with vertical ends it switches the
+    touchdown mode but keeps the free end and the whole cut span, and its G grows past the free slab's
+    (docs/weac.md, "Touchdown"). A vertical-ended column's G with touchdown is therefore its own free G times
+    what touchdown leaves of each mode on the same column with slope-normal ends (:func:`_touchdown_share`).
     """
+    if touchdown and column.column_ends == "vertical":
+        free = _gdif(column, cut, touchdown=False)
+        share = _touchdown_share(replace(column, column_ends="slope_normal"), cut)
+        G_I, G_II = free[1] * share[0], free[2] * share[1]
+        return G_I + G_II, G_I, G_II
+    return _gdif(column, cut, touchdown)
+
+
+def _gdif(column: StaticColumn, cut: float, touchdown: bool) -> tuple[float, float, float]:
+    """weac's ``gdif`` ``(G, G_I, G_II)`` (J/m^2) of ``column`` at ``cut`` (m), as weac computes it."""
     s = _solve(column, cut, touchdown=touchdown)
     return tuple(float(g) for g in s.model.gdif(s.C, s.phi, **s.seg, unit="J/m^2"))
+
+
+def _touchdown_share(column: StaticColumn, cut: float) -> tuple[float, float]:
+    """``(G_I, G_II)`` with touchdown over without, on ``column`` (slope-normal ends) at ``cut`` (m): 1 while the
+    cut slab hangs free; a mode without a free G keeps its own (a share of 1)."""
+    free, rest = _gdif(column, cut, touchdown=False), _gdif(column, cut, touchdown=True)
+    return tuple(r / f if f > 0.0 else 1.0 for f, r in zip(free[1:], rest[1:], strict=True))
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,8 @@ from .fmt import env_note, fx, table
 def _reading(key: str) -> str:
     if key == "g_at_10cm":
         return "weac's G 10 cm past the crack's start over w_f (slower rise: ARR)"
+    if key == "g_min":
+        return "the least of weac's G with touchdown past the start over w_f (lower: ARR)"
     return f"P(ARR), correlation length {key.removeprefix('p_arr_')} m"
 
 
@@ -75,8 +77,12 @@ def render_arrest(data: dict, ctx) -> list[str]:
     lengths = ", ".join(f"{xi:g}" for xi in data["correlation_lengths_m"])
     where = "" if not some else " (observed " + ", ".join(f"{c['observed']} {fx(max(c['p_arr'].values()), 2)}"
                                                          for c in some) + ")"
+    stops = data.get("static_arrests")
+    if stops is not None:
+        out += ["- **A uniform layer, no scatter** (Rosendahl et al. 2025): weac's G with touchdown falls below "
+                "w_f at one of the points read past the start, a static balance that stops the crack, in "
+                + ", ".join(f"{stops[c]} of the {n[c]} {c}" for c in FIELD_CLASSES) + " columns."]
     out += [f"- **At the frame's scale** P(ARR) exceeds {STOPS:g} at one of the correlation lengths ({lengths} m) "
-            f"in {len(some)} of {len(read)} columns{where}; the largest is {fx(top, 3)}. In the others weac's G "
-            "past the start grows faster than a tougher patch of the documented scatter makes up.", "",
+            f"in {len(some)} of {len(read)} columns{where}; the largest is {fx(top, 3)}.", "",
             env_note(data)]
     return out
