@@ -9,7 +9,13 @@ distance against the column (``mpm_warp.field.mechanisms``). Summed by observed 
 AUC of the peak stress after the call and of a through-crack. A case's record is kept in ``--work`` (a rerun
 resumes). Writes ``benchmarks/field/results/field_landing.json``.
 
-Usage: ``python benchmarks/field/landing.py --runs RUNDIR --work DIR [--after 0.1]``; ``--quick``: one case.
+The slab's stress is read twice: over the whole slab (its rows next to the weak layer included, where the grid
+ties the slab to the collapsing layer and it cracks along the bed) and over its body (``body_peak_after``),
+the reading the model's P(SF) takes at the call (docs/field.md, "The outcome as a probability").
+
+Usage: ``python benchmarks/field/landing.py --runs RUNDIR --work DIR [--after 0.1] [--cases JSON] [--part K/N]``
+(``--cases``: only the scored columns of a disagreements file; ``--part``: the K-th of N interleaved shares, for
+N processes on one ``--work``; a run without ``--part`` gathers every share's records); ``--quick``: one case.
 """
 
 from __future__ import annotations
@@ -17,6 +23,7 @@ from __future__ import annotations
 import glob
 import json
 import os
+import statistics
 import sys
 import warnings
 
@@ -59,18 +66,37 @@ def summary(rows: list[dict]) -> dict:
     for c in FIELD_CLASSES:
         of = [r for r in ok if r["observed"] == c]
         after = sorted(r["peak_stress_ratio_after"] for r in of if r["peak_stress_ratio_after"] is not None)
+        body = [r["body_peak_after"] for r in of if r.get("body_peak_after") is not None]
         inside = [r for r in of if r["touchdown_distance"] < r["column_m"]]
         by[c] = {"cases": len(of), "through_crack": sum(r["slab_through_crack_time"] is not None for r in of),
                  "touchdown_inside": len(inside),
                  "through_crack_touchdown_inside": sum(r["slab_through_crack_time"] is not None for r in inside),
-                 "median_peak_after": after[len(after) // 2] if after else None}
+                 "median_peak_after": after[len(after) // 2] if after else None,
+                 "median_body_peak_after": statistics.median(body) if body else None, "body_read": len(body)}
     se = [r for r in ok if r["observed"] in ("SF", "END") and r["peak_stress_ratio_after"] is not None]
     y = [r["observed"] == "SF" for r in se]
     two = 0 < sum(y) < len(y)
+    sb = [r for r in se if r.get("body_peak_after") is not None]
+    yb = [r["observed"] == "SF" for r in sb]
     return {"by_observed": by,
+            "auc_body_peak_after": float(roc_auc_score(yb, [r["body_peak_after"] for r in sb]))
+            if 0 < sum(yb) < len(yb) else None, "sf_end_body_cases": len(sb),
             "auc_peak_after": float(roc_auc_score(y, [r["peak_stress_ratio_after"] for r in se])) if two else None,
             "auc_through_crack": float(roc_auc_score(y, [r["slab_through_crack_time"] is not None for r in se]))
             if two else None, "sf_end_cases": len(se)}
+
+
+def _part(p, text: str | None) -> tuple[int, int] | None:
+    """``(K, N)`` of ``--part K/N``, or the parser's one-line error."""
+    if text is None:
+        return None
+    try:
+        k, n = (int(x) for x in text.split("/"))
+    except ValueError:
+        k = n = 0
+    if not 1 <= k <= n:
+        p.error(f"--part = {text!r}: K/N with 1 <= K <= N, e.g. 1/2")
+    return k, n
 
 
 def main(argv=None) -> int:
@@ -78,7 +104,10 @@ def main(argv=None) -> int:
     p.add_argument("--runs", required=True, help="a field batch's runs folder (field_batch.py --runs)")
     p.add_argument("--work", required=True, help="folder of the copies and the per-case records (kept: resumes)")
     p.add_argument("--after", type=float, default=0.1, help="simulated time past the END call (s, default 0.1)")
+    p.add_argument("--cases", help="a disagreements file (field_disagreements.json): only its scored columns")
+    p.add_argument("--part", help="K/N: run only the K-th of N interleaved shares of the cases (1 <= K <= N)")
     args = p.parse_args(argv)
+    share = _part(p, args.part)
     warnings.filterwarnings("ignore")
     recs = []
     for f in sorted(glob.glob(os.path.join(args.runs, "*.json"))):
@@ -86,13 +115,22 @@ def main(argv=None) -> int:
             r = json.load(fh)
         if r.get("status") == "ok" and r.get("predicted") == "END" and r.get("observed"):
             recs.append(r)
+    if args.cases:
+        with open(args.cases) as fh:
+            keep = {c["id"] for c in json.load(fh)["cases"] if c["observed"] in FIELD_CLASSES}
+        recs = [r for r in recs if r["id"] in keep]
     recs = recs[:1] if args.quick else recs
+    if share is not None:
+        recs = recs[share[0] - 1::share[1]]
     rows = []
     for r in recs:
         rows.append(one(r, args.runs, args.work, args.after))
         x = rows[-1]
         print(f"{x['test']} ({x['observed']}): through-crack {x.get('slab_through_crack_time')}, peak after "
               f"{x.get('peak_stress_ratio_after')}", flush=True)
+    if share is not None:
+        print(f"part {share[0]}/{share[1]}: {len(rows)} records in {args.work}")
+        return 0
     data = {"name": "field_landing", "runs": os.path.basename(os.path.normpath(args.runs)), "after_s": args.after,
             "environment": environment("cpu"), "summary": summary(rows), "cases": rows}
     path = write_json("field_landing", data, out_dir(args, RESULTS, "field_landing"))

@@ -61,7 +61,8 @@ def run_on(run_dir: str, case_id: str, work_dir: str, after: float = 0.1, n_thre
         ``call_time`` (s, the last frame of the batch's run), ``slab_through_crack_time`` (s after the call, None:
         none), ``slab_through_crack_at`` (m from the cut end), ``peak_stress_ratio_before`` and ``_after`` (-),
         ``touchdown_max`` (m, the longest touchdown distance the run measured after the call), ``front_final``
-        (m), ``sim_time_after`` (s), ``wall_s``.
+        (m), ``sim_time_after`` (s), ``wall_s``; ``body_peak_before`` and ``_after``: the same of the slab's body,
+        its rows beyond the grid's tie to the weak layer (None where the run has no such series).
     """
     from ..errors import InvalidArgument
     from ..runner import resume
@@ -94,6 +95,8 @@ def run_on(run_dir: str, case_id: str, work_dir: str, after: float = 0.1, n_thre
             "slab_through_crack_at": float(crack[later][hit[0]]) if hit.size else None,
             "peak_stress_ratio_before": _peak(s.get("slab_stress_ratio", [])[:n_before]),
             "peak_stress_ratio_after": _peak(s.get("slab_stress_ratio", [])[later]),
+            "body_peak_before": _peak(s.get("slab_body_stress_ratio", [])[:n_before]),
+            "body_peak_after": _peak(s.get("slab_body_stress_ratio", [])[later]),
             "touchdown_max": _peak(s.get("touchdown", [])[later]),
             "front_final": float(s["front"][-1]), "sim_time_after": float(t[-1] - t_call),
             "outcome_after": res.scene_result.get("outcome", {}).get("class"), "wall_s": wall}
