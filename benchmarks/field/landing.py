@@ -15,7 +15,10 @@ the reading the model's P(SF) takes at the call (docs/field.md, "The outcome as 
 
 Usage: ``python benchmarks/field/landing.py --runs RUNDIR --work DIR [--after 0.1] [--cases JSON] [--part K/N]``
 (``--cases``: only the scored columns of a disagreements file; ``--part``: the K-th of N interleaved shares, for
-N processes on one ``--work``; a run without ``--part`` gathers every share's records); ``--quick``: one case.
+N processes on one ``--work``; a run without ``--part`` gathers every share's records; ``--finished``: only the
+records already in ``--work``, running nothing, for a study stopped early; ``--observed SF,END``: only those
+observed classes). A record in ``--work`` from another runs folder or another ``--after`` stops the study with
+one line, never reused or overwritten. ``--quick``: one case.
 """
 
 from __future__ import annotations
@@ -27,9 +30,10 @@ import statistics
 import sys
 import warnings
 
+from mpm_warp.errors import InvalidArgument
 from mpm_warp.field.mechanisms import touchdown_distance
-from mpm_warp.field.run_on import run_on, scenario_of
-from mpm_warp.field.scores import FIELD_CLASSES
+from mpm_warp.field.run_on import kept_record, run_on, scenario_of
+from mpm_warp.field.scores import FIELD_CLASSES, field_class
 from mpm_warp.io.records import write_record
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -40,11 +44,12 @@ RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 def one(rec: dict, run_dir: str, work: str, after: float) -> dict:
     """The landing record of the batch record ``rec`` (kept in ``work``; read back when there)."""
     path = os.path.join(work, rec["id"] + ".landing.json")
-    if os.path.exists(path):
-        with open(path) as fh:
-            return json.load(fh)
+    study = {"runs": os.path.basename(os.path.normpath(run_dir)), "after_s": after}
+    kept = kept_record(path, study)
+    if kept is not None:
+        return kept
     p = scenario_of(run_dir, rec["id"]).scene
-    out = {k: rec.get(k) for k in ("id", "test", "observed", "predicted", "slab_depth", "slab_density")}
+    out = {**study, **{k: rec.get(k) for k in ("id", "test", "observed", "predicted", "slab_depth", "slab_density")}}
     out.update(touchdown_distance=touchdown_distance(p), column_m=float(p.length))
     try:
         out.update(status="ok", **run_on(run_dir, rec["id"], work, after))
@@ -106,6 +111,9 @@ def main(argv=None) -> int:
     p.add_argument("--after", type=float, default=0.1, help="simulated time past the END call (s, default 0.1)")
     p.add_argument("--cases", help="a disagreements file (field_disagreements.json): only its scored columns")
     p.add_argument("--part", help="K/N: run only the K-th of N interleaved shares of the cases (1 <= K <= N)")
+    p.add_argument("--finished", action="store_true", help="summarise the records already in --work, run nothing")
+    p.add_argument("--observed", default=",".join(FIELD_CLASSES),
+                   help="the observed classes to run on, comma-separated (default END,SF,ARR)")
     args = p.parse_args(argv)
     share = _part(p, args.part)
     warnings.filterwarnings("ignore")
@@ -115,6 +123,10 @@ def main(argv=None) -> int:
             r = json.load(fh)
         if r.get("status") == "ok" and r.get("predicted") == "END" and r.get("observed"):
             recs.append(r)
+    classes = [c.strip() for c in args.observed.split(",") if c.strip()]
+    if not classes or any(c not in FIELD_CLASSES for c in classes):
+        p.error(f"--observed = {args.observed!r}: a comma-separated subset of {','.join(FIELD_CLASSES)}")
+    recs = [r for r in recs if field_class(r["observed"]) in classes]
     if args.cases:
         with open(args.cases) as fh:
             keep = {c["id"] for c in json.load(fh)["cases"] if c["observed"] in FIELD_CLASSES}
@@ -122,9 +134,16 @@ def main(argv=None) -> int:
     recs = recs[:1] if args.quick else recs
     if share is not None:
         recs = recs[share[0] - 1::share[1]]
+    planned = len(recs)
+    if args.finished:
+        recs = [r for r in recs if os.path.exists(os.path.join(args.work, r["id"] + ".landing.json"))]
     rows = []
     for r in recs:
-        rows.append(one(r, args.runs, args.work, args.after))
+        try:
+            rows.append(one(r, args.runs, args.work, args.after))
+        except InvalidArgument as e:
+            print(f"landing: {e}", file=sys.stderr)
+            return 2
         x = rows[-1]
         print(f"{x['test']} ({x['observed']}): through-crack {x.get('slab_through_crack_time')}, peak after "
               f"{x.get('peak_stress_ratio_after')}", flush=True)
@@ -132,6 +151,7 @@ def main(argv=None) -> int:
         print(f"part {share[0]}/{share[1]}: {len(rows)} records in {args.work}")
         return 0
     data = {"name": "field_landing", "runs": os.path.basename(os.path.normpath(args.runs)), "after_s": args.after,
+            "planned": planned,
             "environment": environment("cpu"), "summary": summary(rows), "cases": rows}
     path = write_json("field_landing", data, out_dir(args, RESULTS, "field_landing"))
     print(f"{path}: {len(rows)} cases")

@@ -20,7 +20,27 @@ import numpy as np
 
 from ..io import checkpoint_path_for, read_run
 
-__all__ = ["run_on", "scenario_of"]
+__all__ = ["run_on", "scenario_of", "kept_record"]
+
+
+def kept_record(path: str, study: dict) -> dict | None:
+    """The record a study kept at ``path`` (JSON) when it was made by the same ``study`` (every key of it the
+    same: the runs folder, the time run on), None where there is none; a record of another study raises
+    :class:`~mpm_warp.errors.InvalidArgument` naming it, and is neither reused nor overwritten."""
+    import json
+
+    from ..errors import InvalidArgument
+
+    if not os.path.exists(path):
+        return None
+    with open(path) as fh:
+        kept = json.load(fh)
+    other = {k: kept.get(k) for k in study}
+    if other != study:
+        raise InvalidArgument("work", os.path.dirname(path) or ".",
+                              f"a folder without records of another study: {os.path.basename(path)} was made with "
+                              f"{other}, this study is {study}")
+    return kept
 
 
 def scenario_of(run_dir: str, case_id: str):

@@ -143,7 +143,8 @@ def render_forecast(data: dict, ctx) -> list[str]:
 
 
 @section("field", "The landing: the columns called END, run on as the slab lands", "field/results/field_landing.json",
-         lambda d: f"python benchmarks/field/landing.py --runs RUNDIR --work DIR --after {d['after_s']:g}",
+         lambda d: f"python benchmarks/field/landing.py --runs RUNDIR --work DIR --after {d['after_s']:g}"
+                   + (" --cases field_disagreements.json" if "auc_body_peak_after" in d["summary"] else ""),
          question="The batch stops a case once it calls END; the cut slab then falls onto its collapsed weak layer "
                   "in front of the observer. Does the model's slab break as it lands, and more often where the "
                   "observer wrote SF?",
@@ -151,14 +152,22 @@ def render_forecast(data: dict, ctx) -> list[str]:
 def render_landing(data: dict, ctx) -> list[str]:
     s = data["summary"]
     by = s["by_observed"]
+    body = "auc_body_peak_after" in s
     rows = [[c, str(v["cases"]), str(v["through_crack"]), str(v["touchdown_inside"]),
-             str(v["through_crack_touchdown_inside"]), fx(v["median_peak_after"], 1)] for c, v in by.items()]
+             str(v["through_crack_touchdown_inside"]), fx(v["median_peak_after"], 1 if not body else 2)]
+            + ([fx(v["median_body_peak_after"], 2)] if body else []) for c, v in by.items()]
     ok = [c for c in data["cases"] if c["status"] == "ok"]
-    out = [f"The {len(data['cases'])} cases of the batch `{data['runs']}` called END whose runs had finished, each "
+    stopped = data.get("planned", len(data["cases"])) > len(data["cases"])
+    out = [(f"{len(data['cases'])} of the {data['planned']} scored cases" if stopped else
+            f"The {len(data['cases'])} cases") + f" of the batch `{data['runs']}` called END whose runs had "
+           "finished, each "
            f"resumed on a copy for {fx(data['after_s'], 2)} s past its call, stopping at a crack through the slab "
-           "(the batch's own detector). Touchdown inside: Heierli's touchdown distance shorter than the column.", ""]
+           "(the batch's own detector). Touchdown inside: Heierli's touchdown distance shorter than the column."
+           + (" The study was stopped there: the others were not run on (the cases are taken in the order of "
+              "their ids, interleaved between two processes)." if stopped else ""), ""]
     out += table(["observed", "cases", "slab cracked through", "touchdown inside the column",
-                  "of those, cracked through", "median peak stress over strength after the call"], rows)
+                  "of those, cracked through", "median peak stress over strength after the call"]
+                 + (["the same, the slab's body"] if body else []), rows)
     through = sum(v["through_crack"] for v in by.values())
     above = sum(c["peak_stress_ratio_after"] is not None and c["peak_stress_ratio_after"] >= 1.0 for c in ok)
     out += ["", f"- {through} of {len(ok)} slabs cracked through within {fx(data['after_s'], 2)} s of the call; "
@@ -166,10 +175,16 @@ def render_landing(data: dict, ctx) -> list[str]:
             f"call tells SF from END with an AUC of {fx(s['auc_peak_after'], 2)} ({s['sf_end_cases']} SF and END "
             "records)."
             + (" In the model, the landing damages the slab without breaking it through, in every class." if
-               through == 0 and above else ""),
-            "- The peak stress column was read by the monitor of that commit, which took a cracked particle's "
-            "unsoftened stress: past a particle's strength it measures how far its crack opened, not what it "
-            "carries (never more than its strength). docs/field.md, \"Why the slab's stress read 20-124 times its "
-            "strength\", has the slab's carried stress: at most 0.38-0.45 of its strength up to the call on two "
-            "of these columns.", "", env_note(data)]
+               through == 0 and above else "")]
+    if body:
+        out += [f"- **The slab's body** (its rows beyond the grid's tie to the weak layer, the reading of the model's "
+                f"P(SF)): its peak after the call tells SF from END with an AUC of {fx(s['auc_body_peak_after'], 2)} "
+                f"({s['sf_end_body_cases']} SF and END records). The stress is what a particle carries: 1 once it "
+                "has cracked, never more.", "", env_note(data)]
+    else:
+        out += ["- The peak stress column was read by the monitor of that commit, which took a cracked particle's "
+                "unsoftened stress: past a particle's strength it measures how far its crack opened, not what it "
+                "carries (never more than its strength). docs/field.md, \"Why the slab's stress read 20-124 times "
+                "its strength\", has the slab's carried stress: at most 0.38-0.45 of its strength up to the call on "
+                "two of these columns.", "", env_note(data)]
     return out
