@@ -10,8 +10,10 @@ AUC of the peak stress after the call and of a through-crack. A case's record is
 resumes). Writes ``benchmarks/field/results/field_landing.json``.
 
 The slab's stress is read twice: over the whole slab (its rows next to the weak layer included, where the grid
-ties the slab to the collapsing layer and it cracks along the bed) and over its body (``body_peak_after``),
-the reading the model's P(SF) takes at the call (docs/field.md, "The outcome as a probability").
+ties the slab to the collapsing layer and it cracks along the bed) and over its body, the reading the model's
+P(SF) takes at the call (docs/field.md, "The outcome as a probability"): its peak over the frames run on
+(``body_peak_after``; a run file written before the body's series records none) and its carried stress at the end,
+from the copy's final checkpoint (``body_at_end``, 1 where a body particle cracked).
 
 Usage: ``python benchmarks/field/landing.py --runs RUNDIR --work DIR [--after 0.1] [--cases JSON] [--part K/N]``
 (``--cases``: only the scored columns of a disagreements file; ``--part``: the K-th of N interleaved shares, for
@@ -34,6 +36,7 @@ from mpm_warp.errors import InvalidArgument
 from mpm_warp.field.mechanisms import touchdown_distance
 from mpm_warp.field.run_on import kept_record, run_on, scenario_of
 from mpm_warp.field.scores import FIELD_CLASSES, field_class
+from mpm_warp.field.studies.at_call import body_stress_ratio
 from mpm_warp.io.records import write_record
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -48,11 +51,13 @@ def one(rec: dict, run_dir: str, work: str, after: float) -> dict:
     kept = kept_record(path, study)
     if kept is not None:
         return kept
-    p = scenario_of(run_dir, rec["id"]).scene
+    sc = scenario_of(run_dir, rec["id"])
+    p = sc.scene
     out = {**study, **{k: rec.get(k) for k in ("id", "test", "observed", "predicted", "slab_depth", "slab_density")}}
     out.update(touchdown_distance=touchdown_distance(p), column_m=float(p.length))
     try:
         out.update(status="ok", **run_on(run_dir, rec["id"], work, after))
+        out["body_at_end"] = body_stress_ratio(work, rec["id"], sc)     # the copy's final checkpoint
     except Exception as e:      # recorded, never stops the others
         out.update(status="failed", error=f"{type(e).__name__}: {e}")
     write_record(path, out, "a landing record", default=str)
@@ -72,18 +77,25 @@ def summary(rows: list[dict]) -> dict:
         of = [r for r in ok if r["observed"] == c]
         after = sorted(r["peak_stress_ratio_after"] for r in of if r["peak_stress_ratio_after"] is not None)
         body = [r["body_peak_after"] for r in of if r.get("body_peak_after") is not None]
+        end = [r["body_at_end"] for r in of if r.get("body_at_end") is not None]
         inside = [r for r in of if r["touchdown_distance"] < r["column_m"]]
         by[c] = {"cases": len(of), "through_crack": sum(r["slab_through_crack_time"] is not None for r in of),
                  "touchdown_inside": len(inside),
                  "through_crack_touchdown_inside": sum(r["slab_through_crack_time"] is not None for r in inside),
                  "median_peak_after": after[len(after) // 2] if after else None,
-                 "median_body_peak_after": statistics.median(body) if body else None, "body_read": len(body)}
+                 "median_body_peak_after": statistics.median(body) if body else None, "body_read": len(body),
+                 "median_body_at_end": statistics.median(end) if end else None,
+                 "body_cracked_at_end": sum(v >= 1.0 for v in end), "body_at_end_read": len(end)}
     se = [r for r in ok if r["observed"] in ("SF", "END") and r["peak_stress_ratio_after"] is not None]
     y = [r["observed"] == "SF" for r in se]
     two = 0 < sum(y) < len(y)
     sb = [r for r in se if r.get("body_peak_after") is not None]
     yb = [r["observed"] == "SF" for r in sb]
+    sz = [r for r in se if r.get("body_at_end") is not None]
+    yz = [r["observed"] == "SF" for r in sz]
     return {"by_observed": by,
+            "auc_body_at_end": float(roc_auc_score(yz, [r["body_at_end"] for r in sz])) if 0 < sum(yz) < len(yz)
+            else None, "sf_end_body_at_end_cases": len(sz),
             "auc_body_peak_after": float(roc_auc_score(yb, [r["body_peak_after"] for r in sb]))
             if 0 < sum(yb) < len(yb) else None, "sf_end_body_cases": len(sb),
             "auc_peak_after": float(roc_auc_score(y, [r["peak_stress_ratio_after"] for r in se])) if two else None,
