@@ -163,7 +163,7 @@ def main(argv=None) -> int:
         print(f"part {share[0]}/{share[1]}: {len(rows)} records in {args.work}")
         return 0
     data = {"name": "field_landing", "runs": os.path.basename(os.path.normpath(args.runs)), "after_s": args.after,
-            "planned": planned,
+            "planned": planned, "observed": classes, "cases_from": os.path.basename(args.cases) if args.cases else None,
             "environment": environment("cpu"), "summary": summary(rows), "cases": rows}
     path = write_json("field_landing", data, out_dir(args, RESULTS, "field_landing"))
     print(f"{path}: {len(rows)} cases")

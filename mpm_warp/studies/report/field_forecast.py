@@ -155,19 +155,23 @@ def render_landing(data: dict, ctx) -> list[str]:
     body = "auc_body_peak_after" in s
     rows = [[c, str(v["cases"]), str(v["through_crack"]), str(v["touchdown_inside"]),
              str(v["through_crack_touchdown_inside"]), fx(v["median_peak_after"], 1 if not body else 2)]
-            + ([fx(v["median_body_peak_after"], 2)] if body else []) for c, v in by.items()]
+            + ([fx(v["median_body_peak_after"], 2) + f" ({v['body_read']})",
+                fx(v.get("median_body_at_end"), 2) + f" ({v.get('body_at_end_read', 0)})",
+                str(v.get("body_cracked_at_end", "-"))] if body else []) for c, v in by.items() if v["cases"]]
     ok = [c for c in data["cases"] if c["status"] == "ok"]
     stopped = data.get("planned", len(data["cases"])) > len(data["cases"])
     out = [(f"{len(data['cases'])} of the {data['planned']} scored cases" if stopped else
             f"The {len(data['cases'])} cases") + f" of the batch `{data['runs']}` called END whose runs had "
-           "finished, each "
+           "finished" + (f" (the {' and '.join(data['observed'])} records of `{data['cases_from']}`)"
+                         if data.get("cases_from") else "") + ", each "
            f"resumed on a copy for {fx(data['after_s'], 2)} s past its call, stopping at a crack through the slab "
            "(the batch's own detector). Touchdown inside: Heierli's touchdown distance shorter than the column."
            + (" The study was stopped there: the others were not run on (the cases are taken in the order of "
               "their ids, interleaved between two processes)." if stopped else ""), ""]
     out += table(["observed", "cases", "slab cracked through", "touchdown inside the column",
-                  "of those, cracked through", "median peak stress over strength after the call"]
-                 + (["the same, the slab's body"] if body else []), rows)
+                  "of those, cracked through", "median peak stress over strength after the call, whole slab"]
+                 + (["the slab body's peak after the call (runs read)", "the body's at the end (runs read)",
+                     "bodies cracked at the end"] if body else []), rows)
     through = sum(v["through_crack"] for v in by.values())
     above = sum(c["peak_stress_ratio_after"] is not None and c["peak_stress_ratio_after"] >= 1.0 for c in ok)
     out += ["", f"- {through} of {len(ok)} slabs cracked through within {fx(data['after_s'], 2)} s of the call; "
@@ -178,9 +182,11 @@ def render_landing(data: dict, ctx) -> list[str]:
                through == 0 and above else "")]
     if body:
         out += [f"- **The slab's body** (its rows beyond the grid's tie to the weak layer, the reading of the model's "
-                f"P(SF)): its peak after the call tells SF from END with an AUC of {fx(s['auc_body_peak_after'], 2)} "
-                f"({s['sf_end_body_cases']} SF and END records). The stress is what a particle carries: 1 once it "
-                "has cracked, never more.", "", env_note(data)]
+                f"P(SF)): its peak over the frames after the call tells SF from END with an AUC of "
+                f"{fx(s['auc_body_peak_after'], 2)} ({s['sf_end_body_cases']} SF and END records whose run file has "
+                f"the body's series); its carried stress at the end of the run-on, from the final checkpoint, with "
+                f"{fx(s.get('auc_body_at_end'), 2)} ({s.get('sf_end_body_at_end_cases', 0)} records). The stress is "
+                "what a particle carries over its strength: 1 once it has cracked, never more.", "", env_note(data)]
     else:
         out += ["- The peak stress column was read by the monitor of that commit, which took a cracked particle's "
                 "unsoftened stress: past a particle's strength it measures how far its crack opened, not what it "
