@@ -144,7 +144,8 @@ def render_forecast(data: dict, ctx) -> list[str]:
 
 @section("field", "The landing: the columns called END, run on as the slab lands", "field/results/field_landing.json",
          lambda d: f"python benchmarks/field/landing.py --runs RUNDIR --work DIR --after {d['after_s']:g}"
-                   + (" --cases field_disagreements.json" if "auc_body_peak_after" in d["summary"] else ""),
+                   + (" --cases field_disagreements.json" if d.get("cases_from") else "")
+                   + (f" --observed {','.join(d['observed'])}" if d.get("observed") else ""),
          question="The batch stops a case once it calls END; the cut slab then falls onto its collapsed weak layer "
                   "in front of the observer. Does the model's slab break as it lands, and more often where the "
                   "observer wrote SF?",
@@ -175,7 +176,8 @@ def render_landing(data: dict, ctx) -> list[str]:
     through = sum(v["through_crack"] for v in by.values())
     above = sum(c["peak_stress_ratio_after"] is not None and c["peak_stress_ratio_after"] >= 1.0 for c in ok)
     out += ["", f"- {through} of {len(ok)} slabs cracked through within {fx(data['after_s'], 2)} s of the call; "
-            f"{above} of {len(ok)} reached their strength somewhere after it. The peak stress over strength after the "
+            f"{above} of {len(ok)} reached their strength somewhere after it (the whole slab, its rows tied to the "
+            "weak layer included). The peak stress over strength after the "
             f"call tells SF from END with an AUC of {fx(s['auc_peak_after'], 2)} ({s['sf_end_cases']} SF and END "
             "records)."
             + (" In the model, the landing damages the slab without breaking it through, in every class." if
