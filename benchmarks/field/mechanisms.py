@@ -17,6 +17,7 @@ Usage: ``python benchmarks/field/mechanisms.py --data DIR`` (DIR: the unpacked p
 from __future__ import annotations
 
 import json
+import math
 import os
 import statistics
 import sys
@@ -31,6 +32,7 @@ from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 DISAGREEMENTS = os.path.join(RESULTS, "field_disagreements.json")
+FORECAST = os.path.join(RESULTS, "field_forecast.json")
 
 #: candidate -> (what it is, +1: a larger value says SF; -1: a smaller one does)
 CANDIDATES = {
@@ -98,27 +100,55 @@ def touchdown_rule(rows: list[dict]) -> dict:
     return {"rule": "SF where touchdown_over_column < 1, else END", **scores(obs, pred)}
 
 
-def information_bar_scores(rows: list[dict], described: list[dict]) -> dict:
-    """The information bar (``mpm_warp.field.information_bar``) on the same columns: its cross-validated
-    P(SF)'s SF-against-END AUC, and its forecast scores (:func:`~mpm_warp.field.forecast.forecast_scores`)."""
+def _forecast(obs: list[str], prob) -> dict:
+    """A forecast's scores without its reliability table, and its SF-against-END AUC."""
     from sklearn.metrics import roc_auc_score
 
     from mpm_warp.field.forecast import forecast_scores
-    from mpm_warp.field.information_bar import information_bar
 
-    obs = [r["observed"] for r in described]
-    feats = [[r["slab_depth_m"], r["slab_density"], r["slope_deg"], r["cut_share"]] for r in rows]
-    prob = information_bar(feats, obs, [case_key(r)[0] for r in rows])
     sf_end = [i for i, o in enumerate(obs) if o in ("SF", "END")]
     sc = forecast_scores(obs, prob)
     sc.pop("reliability")
     return {"auc_sf_vs_end": float(roc_auc_score([obs[i] == "SF" for i in sf_end], prob[sf_end, 1])), **sc}
 
 
+def forecasts(rows: list[dict], described: list[dict], forecast_path: str) -> tuple[dict, dict, dict]:
+    """The information bar (the records' four numbers) and the model's readings calibrated
+    (``mpm_warp.field.calibrated``: the bar's regression and folds on :data:`~mpm_warp.field.calibrated.MODEL_READINGS`)
+    on the same columns, with their scores; the calibration's paired bootstrap intervals against the bar, the
+    climatology and the forecasts ``forecast_path`` (``field_forecast.json``) gives every one of these columns (the
+    raw model, weac's rule, the majority class)."""
+    import numpy as np
+
+    from mpm_warp.field.calibrated import MODEL_READINGS, calibrated_forecast, case_readings
+    from mpm_warp.field.forecast import climatology
+    from mpm_warp.field.forecast_intervals import forecast_intervals
+    from mpm_warp.field.information_bar import information_bar
+
+    obs = [r["observed"] for r in described]
+    pits = [case_key(r)[0] for r in rows]
+    feats = [[r["slab_depth_m"], r["slab_density"], r["slope_deg"], r["cut_share"]] for r in rows]
+    probs = {"calibrated": calibrated_forecast([case_readings(r) for r in described], obs, pits),
+             "information_bar": information_bar(feats, obs, pits), "climatology": climatology(obs)}
+    if os.path.exists(forecast_path):
+        with open(forecast_path) as fh:
+            given = {c["id"]: c for c in json.load(fh)["cases"]}
+        for name in ("model", "weac_static", "majority"):
+            if all(r["id"] in given and given[r["id"]].get(name) for r in described):
+                probs[name] = np.array([given[r["id"]][name] for r in described], dtype=float)
+    scored = {name: _forecast(obs, p) for name, p in probs.items()}
+    calibrated = {"readings": MODEL_READINGS, "forecasts_from": os.path.basename(forecast_path), "scores": scored,
+                  "uncertainty": forecast_intervals(obs, probs, reference="calibrated", resamples=4000),
+                  "missing_readings": {k: int(sum(not math.isfinite(case_readings(r)[j]) for r in described))
+                                       for j, k in enumerate(MODEL_READINGS)}}
+    return scored["information_bar"], calibrated, {k: p.tolist() for k, p in probs.items()}
+
+
 def main(argv=None) -> int:
     p = parser(__doc__, "the first 24 cases")
     p.add_argument("--data", required=True, help="folder of CAAML files the batches read")
     p.add_argument("--cases", default=DISAGREEMENTS, help="the batches' scored cases (field_disagreements.json)")
+    p.add_argument("--forecast", default=FORECAST, help="the same columns' forecasts (field_forecast.json)")
     args = p.parse_args(argv)
     warnings.filterwarnings("ignore")
     with open(args.cases) as fh:
@@ -133,15 +163,21 @@ def main(argv=None) -> int:
               file=sys.stderr)
         return 1
     described = [describe(r, by[case_key(r)]) for r in rows]
+    bar, calibrated, probs = forecasts(rows, described, args.forecast)
+    for k, r in enumerate(described):
+        r["forecast"] = {name: p[k] for name, p in probs.items() if name != "climatology"}
     data = {"name": "field_mechanisms", "cases_from": os.path.basename(args.cases),
             "data": os.path.basename(os.path.normpath(args.data)), "environment": environment("cpu"),
             "counts": {c: sum(r["observed"] == c for r in described) for c in FIELD_CLASSES},
             "candidates": table(described), "touchdown_rule": touchdown_rule(described),
-            "information_bar": information_bar_scores(rows, described), "cases": described}
+            "information_bar": bar, "calibrated": calibrated, "cases": described}
     path = write_json("field_mechanisms", data, out_dir(args, RESULTS, "field_mechanisms"))
     for key, v in data["candidates"].items():
         a, b = v["sf_vs_end"]["auc"], v["arr_vs_rest"]["auc"]
         print(f"{key:24s} SF/END AUC {a if a is None else round(a, 3)}  ARR/rest AUC {b if b is None else round(b, 3)}")
+    for name, sc in calibrated["scores"].items():
+        print(f"{name:16s} RPSS {sc['rpss']:.3f}  balanced accuracy {sc['balanced_accuracy']:.3f}  AUC SF "
+              f"{sc['auc']['SF']:.3f} ARR {sc['auc']['ARR']:.3f}")
     print(f"{path}: {len(described)} cases")
     return 0
 

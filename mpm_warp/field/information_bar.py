@@ -14,7 +14,7 @@ import numpy as np
 from .scores import FIELD_CLASSES
 
 __all__ = ["FEATURES", "CASE_FEATURES", "case_record_features", "case_features", "fold_count", "grouped_folds",
-           "information_bar"]
+           "information_bar", "cross_validated"]
 
 #: the recorded numbers the statistical model reads, and their units
 FEATURES = {"slab_depth": "m", "slab_density": "kg/m^3", "slope_deg": "deg", "cut_share": "-"}
@@ -81,10 +81,6 @@ def information_bar(features, observed: list[str], groups: list[str], *, folds: 
     numpy.ndarray (n, 3)
         Each case's mean out-of-fold probabilities (a class absent from a fold's training cases gets 0 there).
     """
-    from sklearn.linear_model import LogisticRegression
-    from sklearn.pipeline import make_pipeline
-    from sklearn.preprocessing import StandardScaler
-
     from ..errors import InvalidArgument
 
     X = np.asarray(features, dtype=float)
@@ -95,6 +91,21 @@ def information_bar(features, observed: list[str], groups: list[str], *, folds: 
     if fold_count(list(observed), list(groups), folds) < 2 or repeats < 1:
         raise InvalidArgument("folds, repeats, pits", (folds, repeats, len(set(groups))),
                               "folds >= 2, repeats >= 1, and cases from at least 2 pits with 2 of one class")
+    return cross_validated(X, observed, groups, folds=folds, repeats=repeats, seed=seed)
+
+
+def cross_validated(X: np.ndarray, observed: list[str], groups: list[str], *, folds: int, repeats: int,
+                    seed: int) -> np.ndarray:
+    """Out-of-fold P(END), P(SF), P(ARR) (n, 3) of a class-balanced logistic regression on the standardised
+    columns of ``X`` (n, k), averaged over ``repeats`` seeded splits of :func:`grouped_folds` (a pit is never
+    split). A missing value (nan) takes the median of its column over the fold's training cases. A fold whose
+    training cases hold one class gives that class; a class absent from a fold's training cases gets 0 there."""
+    from sklearn.impute import SimpleImputer
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+
+    n = len(observed)
     y = np.asarray(observed, dtype=object)
     prob = np.zeros((n, len(FIELD_CLASSES)))
     for r in range(repeats):
@@ -102,7 +113,8 @@ def information_bar(features, observed: list[str], groups: list[str], *, folds: 
             if len(set(y[train])) < 2:
                 prob[test] += np.array([1.0 if c == y[train][0] else 0.0 for c in FIELD_CLASSES])
                 continue
-            model = make_pipeline(StandardScaler(), LogisticRegression(class_weight="balanced", max_iter=2000))
+            model = make_pipeline(SimpleImputer(strategy="median"), StandardScaler(),
+                                  LogisticRegression(class_weight="balanced", max_iter=2000))
             model.fit(X[train], y[train])
             p = model.predict_proba(X[test])
             for j, c in enumerate(model.classes_):
