@@ -128,6 +128,21 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     assert body_stress_ratio(out, case["id"], sc, tie_cells=-1.0) == pytest.approx(last, rel=1e-6)
     body = case_readings(out, case["id"], sc)["slab_body_stress_ratio_at_call"]
     assert body == pytest.approx(last_body, rel=1e-6) and 0.0 < body <= last     # the monitor's, at the last frame
+    # each record carries the model's readings the calibrated forecast reads: the run's from its files, the closed
+    # forms from its column as recorded, the same a record from before them gets where it is scored
+    from mpm_warp.field.calibrated import MODEL_READINGS, RUN_READINGS, closed_form_readings, run_readings
+
+    for r, c in zip(again.records, cases, strict=True):
+        assert set(MODEL_READINGS) <= set(r)
+        assert {k: r[k] for k in closed_form_readings(c.params)} == closed_form_readings(c.params)
+        ran = run_readings(out, r["id"], scenario_of(out, r["id"]))
+        assert set(ran) == {"run_slab_crack_ratio", *RUN_READINGS} and {k: r[k] for k in ran} == ran
+    assert case["run_slab_body_stress_ratio"] == body and case["run_slab_drop_at_call"] >= 0.0
+    older = {k: v for k, v in case.items() if k not in MODEL_READINGS or k == "static_peak_ratio"}
+    with open(os.path.join(out, case["id"] + ".json"), "w") as fh:   # a record written before the readings
+        json.dump(older, fh)
+    (back,) = [r for r in finished_records(cases, out) if r["id"] == case["id"]]
+    assert {k: back[k] for k in MODEL_READINGS} == {k: case[k] for k in MODEL_READINGS}
     assert body_stress_ratio(out, case["id"], sc, tie_cells=100.0) is None       # 15 cm of slab: no body
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from mpm_warp.errors import InvalidArgument
-from mpm_warp.field.calibrated import MODEL_READINGS, calibrated_forecast, case_readings
+from mpm_warp.field.calibrated import MODEL_READINGS, calibrated_forecast, reading_row
 from mpm_warp.field.forecast import forecast_scores
 from mpm_warp.field.information_bar import cross_validated, information_bar
 from mpm_warp.scenes.pst.outcome import FIELD_CLASSES
@@ -78,12 +78,12 @@ def test_a_missing_reading_takes_the_training_folds_median():
     assert np.isfinite(p_gone).all()
 
 
-def test_case_readings_reads_the_model_and_marks_what_is_missing():
+def test_reading_row_reads_the_model_and_marks_what_is_missing():
     row = {k: 0.5 for k in MODEL_READINGS}
     row["run_slab_body_stress_ratio"] = None
     row["touchdown_distance"] = float("inf")
     row["slab_depth"] = 0.3                                # a record's own number: not read
-    vals = case_readings(row)
+    vals = reading_row(row)
     assert len(vals) == K and sum(math.isnan(v) for v in vals) == 2 and vals.count(0.5) == K - 2
     assert not {"slab_depth", "slab_density", "slope_deg", "cut_share"} & set(MODEL_READINGS)
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from mpm_warp.errors import InvalidArgument
+from mpm_warp.field.calibrated import MODEL_READINGS
 from mpm_warp.field.forecast import (
     brier_per_class,
     climatology,
@@ -153,9 +154,17 @@ def test_score_records_drops_failed_runs_and_scores_every_forecast():
     sc = score_records(recs, resamples=200)
     assert sc["cases"] == 18 and sc["failed"] == 1
     assert set(sc["forecast"]) == {"model", "climatology", "majority", "weac_static", "information_bar"}
+    assert "run_slab_crack_ratio" in sc["forecast_missing"]["calibrated"]        # records without the readings
+    # with the model's readings (here the bar's first number, then noise), the calibration is scored too
+    rng = np.random.default_rng(1)
+    for r, x in zip(recs, X, strict=False):
+        r.update({k: float(x[0]) if j == 0 else float(rng.standard_normal()) for j, k in enumerate(MODEL_READINGS)})
+    sc = score_records(recs, resamples=200)
+    assert set(sc["forecast"]) == {"model", "climatology", "majority", "weac_static", "information_bar",
+                                   "calibrated"}
     assert sc["forecast"]["climatology"]["rpss"] == pytest.approx(0.0)
     assert set(sc["forecast_uncertainty"]["differences"]) == {"climatology", "majority", "weac_static",
-                                                              "information_bar"}
+                                                              "information_bar", "calibrated"}
     # a record from before the stress reading: the model has no forecast, and the scores say why
     del recs[0]["slab_peak_stress_ratio"]
     sc = score_records(recs, resamples=200)
@@ -178,8 +187,10 @@ def test_the_committed_batches_rescore_to_their_committed_scores(path):
     for key, value in data["scores"].items():
         assert again[key] == value, key
     assert again["cases"] == len([c for c in data["cases"] if c["status"] == "ok"])
-    # the cases carry what every forecast reads: the slab's reading and the information bar's numbers
-    assert again["forecast_missing"] == {} and set(again["forecast"]) >= {"model", "information_bar"}
+    # the cases carry what every forecast reads: the slab's reading, the information bar's numbers and the
+    # model's readings the calibration reads
+    assert again["forecast_missing"] == {}
+    assert set(again["forecast"]) >= {"model", "information_bar", "calibrated"}
 
 
 def test_the_run_summary_line_of_the_probabilities():

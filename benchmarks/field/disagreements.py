@@ -25,7 +25,7 @@ import warnings
 
 from mpm_warp.field.batch import gather, run_records
 from mpm_warp.field.run_on import scenario_of
-from mpm_warp.field.studies.at_call import case_readings
+from mpm_warp.field.studies.at_call import case_readings, slab_crack_ratio
 from mpm_warp.scenes.pst.outcome import FIELD_CLASSES
 from mpm_warp.studies.environment import environment, write_json
 from mpm_warp.studies.protocol import out_dir, parser
@@ -38,25 +38,13 @@ def from_checkpoint(run_dir: str, case_id: str, sc) -> tuple[float | None, float
     somewhere), the fastest material's P-wave speed over the slab's fastest (> 1: another material, not the
     slab, sets the time step) and that material's name; Nones without a checkpoint (``sc``: its scenario,
     :func:`scenario_of`)."""
-    import h5py
-
-    from mpm_warp.model import Model
-
-    ck = os.path.join(run_dir, case_id + ".ckpt.h5")
     if sc is None:
         return None, None, None
-    model = Model(sc, "cpu")
     c_p = {name: m.p_wave_speed for name, m in sc.materials.items()}
     slab = max((v for k, v in c_p.items() if k.startswith("slab")), default=None)
     dt_ratio = max(c_p.values()) / slab if slab else None
     fastest = max(c_p, key=c_p.get)
-    with h5py.File(ck, "r") as f:
-        kappa = f["kappa"][:] if "kappa" in f else None
-    groups = [g for g in model.groups if g.material.model == "tensile_cracking"]
-    if kappa is None or not groups:
-        return None, dt_ratio, fastest
-    return max(float(kappa[g.kappa_start:g.kappa_start + g.count].max()) / g.material.tensile_strength
-               for g in groups), dt_ratio, fastest
+    return slab_crack_ratio(run_dir, case_id, sc), dt_ratio, fastest
 
 
 #: m: the energy balance is read up to this far from the far end (where the cut column's last strip lets go)

@@ -4,8 +4,9 @@ Scores a field batch's finished cases (``field_batch.py --runs RUNDIR``, resumed
 ``mpm_warp.field.scoring``: the model's first-order probabilities (its run's slab-body stress under snow's Weibull
 strength scatter; a run recorded before the body's series is read at its call from its final checkpoint,
 ``mpm_warp.field.studies.at_call``), the set's climatology, the majority class and weac's static rule as sure
-forecasts, and the information bar (a logistic regression on slab depth, density, slope and cut share,
-cross-validated by pit).
+forecasts, the information bar (a logistic regression on slab depth, density, slope and cut share,
+cross-validated by pit) and the model's readings calibrated by the same regression and folds
+(``mpm_warp.field.calibrated``; a run from before them read from its files).
 Ranked probability skill against the climatology, Brier score per class, one-vs-rest AUC for SF and ARR,
 balanced accuracy of the most probable class, each with paired bootstrap intervals; and the reliability
 diagram. Writes ``benchmarks/field/results/field_forecast.json`` and ``field_forecast.png``.
@@ -33,7 +34,7 @@ from mpm_warp.studies.protocol import out_dir, parser
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 #: points: where each forecast's bin counts sit against its markers, so that forecasts sharing a bin stay legible
-LABEL_OFFSETS = ((4, 4), (4, -11), (-16, 4), (-16, -11))
+LABEL_OFFSETS = ((4, 4), (4, -11), (-16, 4), (-16, -11), (-6, 10))
 
 
 def reliability_figure(sc: dict, path: str) -> None:
@@ -43,7 +44,8 @@ def reliability_figure(sc: dict, path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = [n for n in ("model", "information_bar", "climatology", "weac_static") if n in sc["forecast"]]
+    names = [n for n in ("model", "calibrated", "information_bar", "climatology", "weac_static")
+             if n in sc["forecast"]]
     fig, axes = plt.subplots(1, 3, figsize=(12, 4.2), sharey=True)
     for ax, cls in zip(axes, FIELD_CLASSES, strict=True):
         ax.plot([0, 1], [0, 1], color="0.6", lw=1, ls="--", label="perfectly reliable")
@@ -54,7 +56,8 @@ def reliability_figure(sc: dict, path: str) -> None:
                 f, o, n = map(np.array, zip(*pts, strict=True))
                 (line,) = ax.plot(f, o, marker="o", label=f"{name} (RPSS {sc['forecast'][name]['rpss']:+.2f})")
                 for fx, ox, nx in pts:         # each forecast's counts in its colour, on its own side of the point
-                    ax.annotate(str(nx), (fx, ox), textcoords="offset points", xytext=LABEL_OFFSETS[k % 4],
+                    ax.annotate(str(nx), (fx, ox), textcoords="offset points",
+                                xytext=LABEL_OFFSETS[k % len(LABEL_OFFSETS)],
                                 fontsize=7, color=line.get_color())
         ax.set(title=f"{cls}", xlabel=f"forecast P({cls})", xlim=(-0.03, 1.03), ylim=(-0.03, 1.03))
     axes[0].set_ylabel("observed frequency (numbers: cases in the bin)")

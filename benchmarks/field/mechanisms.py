@@ -120,7 +120,7 @@ def forecasts(rows: list[dict], described: list[dict], forecast_path: str) -> tu
     raw model, weac's rule, the majority class)."""
     import numpy as np
 
-    from mpm_warp.field.calibrated import MODEL_READINGS, calibrated_forecast, case_readings
+    from mpm_warp.field.calibrated import MODEL_READINGS, calibrated_forecast, reading_row
     from mpm_warp.field.forecast import climatology
     from mpm_warp.field.forecast_intervals import forecast_intervals
     from mpm_warp.field.information_bar import information_bar
@@ -128,7 +128,7 @@ def forecasts(rows: list[dict], described: list[dict], forecast_path: str) -> tu
     obs = [r["observed"] for r in described]
     pits = [case_key(r)[0] for r in rows]
     feats = [[r["slab_depth_m"], r["slab_density"], r["slope_deg"], r["cut_share"]] for r in rows]
-    probs = {"calibrated": calibrated_forecast([case_readings(r) for r in described], obs, pits),
+    probs = {"calibrated": calibrated_forecast([reading_row(r) for r in described], obs, pits),
              "information_bar": information_bar(feats, obs, pits), "climatology": climatology(obs)}
     if os.path.exists(forecast_path):
         with open(forecast_path) as fh:
@@ -139,7 +139,7 @@ def forecasts(rows: list[dict], described: list[dict], forecast_path: str) -> tu
     scored = {name: _forecast(obs, p) for name, p in probs.items()}
     calibrated = {"readings": MODEL_READINGS, "forecasts_from": os.path.basename(forecast_path), "scores": scored,
                   "uncertainty": forecast_intervals(obs, probs, reference="calibrated", resamples=4000),
-                  "missing_readings": {k: int(sum(not math.isfinite(case_readings(r)[j]) for r in described))
+                  "missing_readings": {k: int(sum(not math.isfinite(reading_row(r)[j]) for r in described))
                                        for j, k in enumerate(MODEL_READINGS)}}
     return scored["information_bar"], calibrated, {k: p.tolist() for k, p in probs.items()}
 

@@ -36,6 +36,7 @@ from .. import io
 from ..errors import InvalidArgument
 from ..scenes.pst.params import CRACK_BAND_CELLS
 from .batch_setup import Progress, check_out_dir, check_scheduler, dask_client, dask_log, iter_gather
+from .calibrated import CLOSED_FORMS, add_model_readings, closed_form_readings
 from .case_run import column_step, run_case, run_case_group, write_case_record
 from .cases import FieldCase, FieldRefusal
 from .information_bar import CASE_FEATURES, case_record_features
@@ -129,10 +130,17 @@ def _finished(task: dict, claimed: set | None = None) -> dict | None:
 def finished_records(cases: list, out_dir: str, protocol: FieldProtocol | None = None) -> list[dict]:
     """The records of ``cases`` (in order; :func:`run_cases`'s list) whose runs in ``out_dir`` under ``protocol``
     (default :class:`~.protocol.FieldProtocol`) have finished: what a batch stopped early has measured, scored
-    without running or building anything."""
-    proto, claimed = protocol or FieldProtocol(), set()
-    recs = (_finished({"out_dir": out_dir, "id": _case_id(c, k, proto)}, claimed) for k, c in enumerate(cases))
-    return [r for r in recs if r is not None]
+    without running or building anything; each with the model's readings (:func:`~.calibrated.add_model_readings`)
+    from its files and its case."""
+    from .run_on import scenario_of
+
+    proto, claimed, out = protocol or FieldProtocol(), set(), []
+    for k, c in enumerate(cases):
+        rec = _finished({"out_dir": out_dir, "id": _case_id(c, k, proto)}, claimed)
+        if rec is not None:
+            add_model_readings(rec, out_dir, scenario_of(out_dir, rec["id"]), c.params)
+            out.append(rec)
+    return out
 
 
 def run_records(run_dirs) -> list[tuple[dict, str]]:
@@ -174,7 +182,8 @@ def _task(c: FieldCase, k: int, out_dir, proto, device, refused) -> dict | None:
     source = "given" if wf.reason == "given" else ("read back" if wf.value is not None else wf.reason)
     static = static_view(c.params)
     return {"id": _case_id(c, k, proto), "pit": c.pit, "test": c.test, "observed": field_class(c.outcome),
-            "recorded_cut": c.record.cut_length, **case_record_features(c), "static_class": static.static_class,
+            "recorded_cut": c.record.cut_length, **case_record_features(c), **closed_form_readings(c.params),
+            "static_class": static.static_class,
             "static_peak_ratio": static.peak_ratio, "w_f": params.weak_layer.w_f, "w_f_source": source,
             "setup": note, "scenario": scenario, "out_dir": out_dir, "device": device, "threads": proto.threads}
 
@@ -346,11 +355,13 @@ def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Pro
             done.append(t)
             progress.tasks = len(done)
             progress.refused = len(refused)
-            records[t["id"]] = _finished(t, claimed)
-            if records[t["id"]] is None:
+            records[t["id"]] = rec = _finished(t, claimed)
+            if rec is None:
                 ran.append(t)
                 yield t
-            else:
+            else:                               # a record from before the model's readings gets them here
+                add_model_readings(rec, out_dir, t["scenario"])
+                rec.update({k: t[k] for k in CLOSED_FORMS if k not in rec})
                 progress.done += 1
             progress.show()
 

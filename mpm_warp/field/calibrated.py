@@ -18,7 +18,8 @@ import numpy as np
 
 from .information_bar import cross_validated, fold_count
 
-__all__ = ["MODEL_READINGS", "case_readings", "calibrated_forecast"]
+__all__ = ["MODEL_READINGS", "RUN_READINGS", "CLOSED_FORMS", "reading_row", "closed_form_readings",
+           "run_readings", "add_model_readings", "calibrated_forecast"]
 
 #: the model's readings of a column the calibration reads, and what each is: every reading of the mechanism
 #: study (docs/field.md, "Why thin, light slabs break") that comes from the model and not from the records
@@ -36,7 +37,46 @@ MODEL_READINGS = {
 }
 
 
-def case_readings(row: dict) -> list[float]:
+#: the readings of :data:`MODEL_READINGS` from the run's files, by the key :mod:`.studies.at_call` gives each
+RUN_READINGS = {"run_slab_stress_ratio": "slab_stress_ratio", "run_slab_crack_cover": "slab_crack_cover",
+                "run_slab_body_stress_ratio": "slab_body_stress_ratio_at_call",
+                "run_slab_drop_at_call": "slab_drop_at_call", "run_slab_down_share": "slab_down_share"}
+#: the readings of :data:`MODEL_READINGS` from closed forms of the recorded column (:mod:`.mechanisms`)
+CLOSED_FORMS = ("touchdown_distance", "touchdown_over_column", "brittleness")
+
+
+def closed_form_readings(params) -> dict:
+    """The field column's (PSTParams, as recorded) :data:`CLOSED_FORMS`: Heierli's touchdown distance (m), it over
+    the column's length (-) and the slab's brittleness (-)."""
+    from .mechanisms import brittleness, touchdown_distance
+
+    td = touchdown_distance(params)
+    return {"touchdown_distance": td, "touchdown_over_column": td / params.length, "brittleness": brittleness(params)}
+
+
+def run_readings(run_dir: str, case_id: str, scenario) -> dict:
+    """The run's readings of :data:`MODEL_READINGS` (``run_*``) from the case's run file and final checkpoint in
+    ``run_dir`` (``scenario``: the case's); None each where a file or the scenario is missing."""
+    from .studies.at_call import case_readings, slab_crack_ratio
+
+    got = case_readings(run_dir, case_id, scenario)
+    return {"run_slab_crack_ratio": slab_crack_ratio(run_dir, case_id, scenario),
+            **{key: got[src] for key, src in RUN_READINGS.items()}}
+
+
+def add_model_readings(rec: dict, run_dir: str, scenario, params=None) -> None:
+    """Give a finished field record ``rec`` what it lacks of :data:`MODEL_READINGS`: the run's from its files in
+    ``run_dir`` (``scenario``: its scenario), the closed forms from ``params`` (the column as recorded; None:
+    left as they are). Nothing is written: a record from before the readings gets them where it is scored."""
+    if rec.get("status") != "ok":
+        return
+    if any(k not in rec for k in ("run_slab_crack_ratio", *RUN_READINGS)):
+        rec.update(run_readings(run_dir, rec["id"], scenario))
+    if params is not None and any(k not in rec for k in CLOSED_FORMS):
+        rec.update(closed_form_readings(params))
+
+
+def reading_row(row: dict) -> list[float]:
     """A case's :data:`MODEL_READINGS` in order, nan where one is missing or not finite (a run written before
     that reading existed)."""
     out = []
@@ -53,7 +93,7 @@ def calibrated_forecast(readings, observed: list[str], groups: list[str], *, fol
     Parameters
     ----------
     readings : array_like (n, len(MODEL_READINGS))
-        Each case's :func:`case_readings` (nan: missing; it takes the training folds' median).
+        Each case's :func:`reading_row` (nan: missing; it takes the training folds' median).
     observed : list of str
         The observers' classes (END, SF, ARR).
     groups : list of str

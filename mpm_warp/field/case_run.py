@@ -14,6 +14,7 @@ import time
 import traceback
 
 from .. import io
+from .calibrated import CLOSED_FORMS, add_model_readings
 from .information_bar import CASE_FEATURES
 from .probability import record_probabilities
 from .protocol import decided, run_to_decision
@@ -22,7 +23,7 @@ __all__ = ["run_case", "run_case_group", "write_case_record", "column_step"]
 
 #: the task's fields every record carries
 _TASK_FIELDS = ("id", "pit", "test", "observed", "recorded_cut", "static_class", "static_peak_ratio", "w_f",
-                "w_f_source", "setup", *CASE_FEATURES)
+                "w_f_source", "setup", *CASE_FEATURES, *CLOSED_FORMS)
 
 
 def write_case_record(path: str, obj: dict) -> None:
@@ -62,6 +63,7 @@ def _finish(rec: dict, task: dict, res, threads) -> None:
     record_probabilities(rec)
     io.promote_part(out)
     rec["run_file"] = os.path.basename(out + ".h5")
+    add_model_readings(rec, task["out_dir"], task["scenario"])
 
 
 def _failed(rec: dict, e: BaseException) -> None:

@@ -7,7 +7,8 @@ and is counted apart (``failed``), never as a miss. On them:
   of the balanced accuracy (:mod:`.uncertainty`);
 - probabilities (:mod:`.forecast`, :mod:`.forecast_intervals`): the model's first-order reading of its run
   (:mod:`.probability`), the set's climatology, the majority class and weac's rule as sure forecasts, and the
-  information bar (:mod:`.information_bar`), a cross-validated statistical model of the records' own numbers.
+  information bar (:mod:`.information_bar`), a cross-validated statistical model of the records' own numbers,
+  and the model's readings calibrated by the same regression and folds (:mod:`.calibrated`).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import statistics
 
 import numpy as np
 
+from .calibrated import MODEL_READINGS, calibrated_forecast, reading_row
 from .forecast import climatology, forecast_scores, one_hot
 from .forecast_intervals import forecast_intervals
 from .information_bar import case_features, fold_count, information_bar
@@ -74,6 +76,15 @@ def forecasts(recs: list, *, info_repeats: int = 20) -> tuple[dict, dict]:
                                   "at least")
     else:
         out["information_bar"] = information_bar(feats, obs, pits, folds=FOLDS, repeats=info_repeats)
+    readings = np.array([reading_row(r) for r in recs], dtype=float).reshape(len(recs), len(MODEL_READINGS))
+    absent = [k for k, gone in zip(MODEL_READINGS, np.isnan(readings).all(axis=0), strict=True) if gone]
+    if absent:
+        why["calibrated"] = (f"no record has the model's {', '.join(absent)} (records from before the model's "
+                             "readings, scored without their runs folder)")
+    elif fold_count(obs, pits, FOLDS) < 2:
+        why["calibrated"] = "too few cases to cross-validate: it needs 2 pits and 2 cases of one class at least"
+    else:
+        out["calibrated"] = calibrated_forecast(readings, obs, pits, folds=FOLDS, repeats=info_repeats)
     return out, why
 
 

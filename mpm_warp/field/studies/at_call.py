@@ -21,7 +21,8 @@ import numpy as np
 
 from ...scenes.pst.outcome import TIE_CELLS
 
-__all__ = ["AT_CALL_KEYS", "readings_at_call", "body_stress_ratio", "case_readings", "body_at_call"]
+__all__ = ["AT_CALL_KEYS", "readings_at_call", "body_stress_ratio", "slab_crack_ratio", "case_readings",
+           "body_at_call"]
 
 #: the readings :func:`readings_at_call` returns, each with what it is
 AT_CALL_KEYS = {
@@ -112,6 +113,26 @@ def body_stress_ratio(run_dir: str, case_id: str, scenario, tie_cells: float = T
             r = carried_over_strength(H[g.start:g.end], kappa[g.kappa_start:g.kappa_start + g.count], g.material)
             best = max(best or 0.0, float(r[body].max()))
     return best
+
+
+def slab_crack_ratio(run_dir: str, case_id: str, scenario) -> float | None:
+    """The slab's largest ``kappa`` over its tensile strength in the case's final checkpoint (-; >= 1: it cracked
+    somewhere; the effective, unsoftened stress's history, docs/field.md); None without a checkpoint, a scenario
+    or a cracking slab."""
+    import h5py
+
+    from ...model import Model
+
+    ck = os.path.join(run_dir, case_id + ".ckpt.h5")
+    if scenario is None or not os.path.exists(ck):
+        return None
+    with h5py.File(ck, "r") as f:
+        kappa = f["kappa"][:] if "kappa" in f else None
+    groups = [g for g in Model(scenario, "cpu").groups if g.material.model == "tensile_cracking"]
+    if kappa is None or not groups:
+        return None
+    return max(float(kappa[g.kappa_start:g.kappa_start + g.count].max()) / g.material.tensile_strength
+               for g in groups)
 
 
 def case_readings(run_dir: str, case_id: str, scenario) -> dict:

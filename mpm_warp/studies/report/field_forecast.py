@@ -8,7 +8,7 @@ from .core import section
 from .fmt import check_line, env_note, fx, table
 
 #: the forecasts in the order the tables list them
-NAMES = ("model", "information_bar", "weac_static", "majority", "climatology")
+NAMES = ("model", "calibrated", "information_bar", "weac_static", "majority", "climatology")
 
 
 def _iv(iv, nd: int = 2) -> str:
@@ -47,7 +47,61 @@ def render_mechanisms(data: dict, ctx) -> list[str]:
             *_run_line(c),
             f"- **Brittleness** runs the other way ({fx(c['brittleness']['sf_vs_end']['auc'], 3)}): thin, light "
             "slabs are the least brittle by this measure (the shortest depth for their characteristic length), so "
-            "brittleness does not explain why they break.", "", env_note(data)]
+            "brittleness does not explain why they break.", *_calibrated_lines(data.get("calibrated")), "",
+            env_note(data)]
+    return out
+
+
+def _missing_note(missing: dict) -> str:
+    """How many cases lacked each reading, where any did."""
+    if not missing:
+        return ""
+    listed = ", ".join(f"`{k}` in {n} case{'s' if n != 1 else ''}" for k, n in missing.items())
+    return f"; a missing reading takes the training folds' median ({listed})"
+
+
+#: the calibration's table: the forecasts in order, and what each reads
+CALIBRATED = {"calibrated": "the model's readings, calibrated", "information_bar": "the records' four numbers",
+              "model": "the model's raw probability", "weac_static": "weac's static rule",
+              "majority": "the majority class", "climatology": "the set's class shares"}
+
+
+def _calibrated_lines(cal: dict | None) -> list[str]:
+    """The model's readings calibrated (``mpm_warp.field.calibrated``) beside the bar and the raw forecasts, with
+    the calibration's paired differences; none in an older file."""
+    if not cal:
+        return []
+    sc, unc = cal["scores"], cal["uncertainty"]
+    iv, diff = unc["intervals"], unc["differences"]
+    rows = [[f"`{k}`", what, fx(sc[k]["rpss"], 2) + _iv(iv[k].get("rpss")),
+             fx(sc[k]["balanced_accuracy"], 2) + _iv(iv[k].get("balanced_accuracy")),
+             fx(sc[k]["auc"]["SF"], 2), fx(sc[k]["auc"]["ARR"], 2),
+             " / ".join(fx(sc[k]["brier"][c], 3) for c in FIELD_CLASSES)] for k, what in CALIBRATED.items() if k in sc]
+    missing = {k: n for k, n in cal.get("missing_readings", {}).items() if n}
+    out = ["", "**The model's readings, calibrated** (`mpm_warp/field/calibrated.py`): the information bar's own "
+           "regression and pit-grouped folds, reading the model's "
+           f"{len(cal['readings'])} readings of the table above (every candidate but the records' depth and "
+           "density) where the bar reads the records' four numbers. Its coefficients are statistics fitted on "
+           "other pits, not physical parameters (docs/field.md). Intervals: 95 %, paired bootstrap within each "
+           "class" + _missing_note(missing) + ".", ""]
+    out += table(["forecast", "reads", "RPSS", "balanced accuracy", "AUC SF", "AUC ARR", "Brier END / SF / ARR"],
+                 rows)
+    out += [""]
+    for k in ("information_bar", "model", "weac_static"):
+        if k in diff:
+            d = diff[k]
+            out.append(f"- calibrated minus `{k}`: RPSS {fx(d['rpss']['value'], 2)}{_iv(d['rpss']['interval'])} "
+                       f"(better in {fx(d['rpss']['share_better'], 2)} of the draws), balanced accuracy "
+                       f"{fx(d['balanced_accuracy']['value'], 2)}{_iv(d['balanced_accuracy']['interval'])}.")
+    c, bar, weac = sc["calibrated"], sc["information_bar"], sc.get("weac_static", {}).get("rpss")
+    out += ["", check_line("the model's readings, calibrated, have skill",
+                           "RPSS above the climatology's (0) and above weac's rule's",
+                           c["rpss"] > 0.0 and (weac is None or c["rpss"] > weac),
+                           f"{fx(c['rpss'], 2)} against weac's {fx(weac, 2)}"),
+            check_line("the model's readings, calibrated, carry what the records carry",
+                       "balanced accuracy of the most probable class at least the information bar's",
+                       c["balanced_accuracy"] >= bar["balanced_accuracy"],
+                       f"{fx(c['balanced_accuracy'], 3)} against {fx(bar['balanced_accuracy'], 3)}")]
     return out
 
 
@@ -124,22 +178,28 @@ def render_forecast(data: dict, ctx) -> list[str]:
                   "balanced accuracy (most probable)"], rows)
     for name, why in sc.get("forecast_missing", {}).items():
         out += ["", f"- `{name}`: no forecast: {why}."]
-    m = f.get("model")
-    if m is not None:
-        weac = f.get("weac_static", {}).get("rpss")
-        bar = f.get("information_bar", {}).get("balanced_accuracy")
-        complete = sc["cases"] >= drawn
-        out += ["", check_line("the model's skill", "RPSS above the climatology's (0) and above weac's rule's",
-                               (m["rpss"] > 0.0 and (weac is None or m["rpss"] > weac)) if complete else None,
-                               f"{fx(m['rpss'], 2)} against weac's {fx(weac, 2)}"
-                               + ("" if complete else f"; {sc['cases']} of {drawn} drawn cases finished")),
-                check_line("the model's classes against the information bar",
-                           "balanced accuracy of its most probable class at least the bar's",
-                           (bar is None or m["balanced_accuracy"] >= bar) if complete else None,
-                           f"{fx(m['balanced_accuracy'], 2)} against {fx(bar, 2)}"
-                           + ("" if complete else "; the draw is not complete"))]
+    complete = sc["cases"] >= drawn
+    for name, who in (("model", "the model's"), ("calibrated", "the calibrated readings'")):
+        if name in f:
+            out += ["", *_aim_checks(who, f[name], f, complete, sc["cases"], drawn)]
     out += ["", env_note(data)]
     return out
+
+
+def _aim_checks(who: str, m: dict, f: dict, complete: bool, cases: int, drawn: int) -> list[str]:
+    """The issue's aim for one forecast ``m``: skill above the climatology's and weac's, balanced accuracy at least
+    the information bar's (open while the draw is not complete)."""
+    weac = f.get("weac_static", {}).get("rpss")
+    bar = f.get("information_bar", {}).get("balanced_accuracy")
+    return [check_line(f"{who} skill", "RPSS above the climatology's (0) and above weac's rule's",
+                       (m["rpss"] > 0.0 and (weac is None or m["rpss"] > weac)) if complete else None,
+                       f"{fx(m['rpss'], 2)} against weac's {fx(weac, 2)}"
+                       + ("" if complete else f"; {cases} of {drawn} drawn cases finished")),
+            check_line(f"{who} classes against the information bar",
+                       "balanced accuracy of its most probable class at least the bar's",
+                       (bar is None or m["balanced_accuracy"] >= bar) if complete else None,
+                       f"{fx(m['balanced_accuracy'], 3)} against {fx(bar, 3)}"
+                       + ("" if complete else "; the draw is not complete"))]
 
 
 @section("field", "The landing: the columns called END, run on as the slab lands", "field/results/field_landing.json",
