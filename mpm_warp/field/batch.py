@@ -36,7 +36,7 @@ from .. import io
 from ..errors import InvalidArgument
 from ..scenes.pst.params import CRACK_BAND_CELLS
 from .batch_setup import Progress, check_out_dir, check_scheduler, dask_client, dask_log, iter_gather
-from .calibrated import CLOSED_FORMS, add_model_readings, closed_form_readings
+from .calibrated import CLOSED_FORMS, MODEL_READINGS, add_model_readings, closed_form_readings
 from .case_run import column_step, run_case, run_case_group, write_case_record
 from .cases import FieldCase, FieldRefusal
 from .information_bar import CASE_FEATURES, case_record_features
@@ -127,19 +127,23 @@ def _finished(task: dict, claimed: set | None = None) -> dict | None:
     return None
 
 
-def finished_records(cases: list, out_dir: str, protocol: FieldProtocol | None = None) -> list[dict]:
+def finished_records(cases: list, out_dir: str, protocol: FieldProtocol | None = None,
+                     missing: list | None = None) -> list[dict]:
     """The records of ``cases`` (in order; :func:`run_cases`'s list) whose runs in ``out_dir`` under ``protocol``
     (default :class:`~.protocol.FieldProtocol`) have finished: what a batch stopped early has measured, scored
     without running or building anything; each with the model's readings (:func:`~.calibrated.add_model_readings`)
-    from its files and its case."""
+    from its files and its case. The cases without a finished run go to ``missing`` where it is given."""
     from .run_on import scenario_of
 
     proto, claimed, out = protocol or FieldProtocol(), set(), []
     for k, c in enumerate(cases):
         rec = _finished({"out_dir": out_dir, "id": _case_id(c, k, proto)}, claimed)
-        if rec is not None:
-            add_model_readings(rec, out_dir, scenario_of(out_dir, rec["id"]), c.params)
-            out.append(rec)
+        if rec is None:
+            if missing is not None:
+                missing.append(c)
+            continue
+        add_model_readings(rec, out_dir, scenario_of(out_dir, rec["id"]), c.params)
+        out.append(rec)
     return out
 
 
@@ -381,8 +385,8 @@ def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Pro
 #: the columns of cases.csv
 CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "p_end", "p_sf", "p_arr", "static_class",
                 "static_peak_ratio", "recorded_cut", "runaway_cut", "slab_fracture_at", "slab_peak_stress_ratio",
-                "slab_peak_body_stress_ratio", *CASE_FEATURES, "w_f", "w_f_source", "setup", "particles", "steps",
-                "threads", "workers", "wall_s", "run_file", "error")
+                "slab_peak_body_stress_ratio", *CASE_FEATURES, *(k for k in MODEL_READINGS if k != "static_peak_ratio"),
+                "w_f", "w_f_source", "setup", "particles", "steps", "threads", "workers", "wall_s", "run_file", "error")
 
 
 def _write_outputs(out_dir: str, recs: list, refused: list) -> None:

@@ -43,12 +43,23 @@ def select(cases, per_class: int, seed: int, measured: bool = True) -> tuple[lis
 def finished_draw(data: str, runs: str, per_class: int, seed: int, measured: bool = False,
                   protocol=None) -> tuple[list[dict], dict]:
     """The records of the draw's cases (:func:`select` of the pits in ``data``) whose runs in ``runs`` under
-    ``protocol`` (default the field protocol) have finished, in draw order; and what was drawn."""
-    from .batch import finished_records, gather
+    ``protocol`` (default the field protocol) have finished, in draw order; and what was drawn, with how many of
+    the drawn cases without a finished run the protocol refuses when it builds them (``refused_at_build``: the
+    particle budget, a column the model cannot represent): with those, the draw is whole."""
+    from ..errors import InvalidArgument
+    from .batch import case_scenario, finished_records, gather
     from .protocol import FieldProtocol
 
+    proto = (protocol or FieldProtocol()).validate()
     cases, refused = gather([data], calibrate=False)
     chosen, counts = select(cases, per_class, seed, measured=measured)
-    recs = finished_records(chosen, runs, (protocol or FieldProtocol()).validate())
+    missing = []
+    recs = finished_records(chosen, runs, proto, missing=missing)
+    at_build = 0
+    for c in missing:
+        try:
+            at_build += case_scenario(c, proto)[0] is None
+        except InvalidArgument:
+            at_build += 1
     return recs, {"runnable": len(cases), "refused": len(refused), **counts, "seed": seed, "per_class": per_class,
-                  "finished": len(recs)}
+                  "finished": len(recs), "refused_at_build": at_build}

@@ -170,7 +170,9 @@ def render_forecast(data: dict, ctx) -> list[str]:
     drawn = sum(sel.get(k, 0) for k in FIELD_CLASSES) + sel.get("measured", 0)
     what = (f"the {sel['measured']} columns with measured slab densities and the draw by class, "
             if sel.get("measured") else "the stratified draw, ")
-    out = [f"The {sc['cases']} finished cases of {what}{drawn} drawn ({sel.get('per_class')} a class, seed "
+    at_build = sel.get("refused_at_build")
+    built = "" if at_build is None else f"{at_build} refused when built, "
+    out = [f"The {sc['cases']} finished cases of {what}{drawn} drawn ({built}{sel.get('per_class')} a class, seed "
            f"{sel.get('seed')}), interleaved by class. The model: one run a case, read at first order "
            f"({_reading(data)} under snow's Weibull strength scatter, docs/field.md). Intervals: 95 %, "
            "paired bootstrap within each class.", ""]
@@ -178,7 +180,7 @@ def render_forecast(data: dict, ctx) -> list[str]:
                   "balanced accuracy (most probable)"], rows)
     for name, why in sc.get("forecast_missing", {}).items():
         out += ["", f"- `{name}`: no forecast: {why}."]
-    complete = sc["cases"] >= drawn
+    complete = sc["cases"] + (at_build or 0) >= drawn
     for name, who in (("model", "the model's"), ("calibrated", "the calibrated readings'")):
         if name in f:
             out += ["", *_aim_checks(who, f[name], f, complete, sc["cases"], drawn)]
