@@ -24,6 +24,7 @@ import warnings
 
 import numpy as np
 
+from mpm_warp.field.calibrated import MODEL_READINGS
 from mpm_warp.field.draw import finished_draw
 from mpm_warp.field.probability import slab_reading
 from mpm_warp.field.scores import FIELD_CLASSES
@@ -69,7 +70,8 @@ def reliability_figure(sc: dict, path: str) -> None:
 
 
 def made_up(n: int = 30, seed: int = 0) -> list[dict]:
-    """A small made-up batch (``--quick``): three classes, two cases a pit, a model that half knows SF."""
+    """A small made-up batch (``--quick``): three classes, two cases a pit, a model that half knows SF, the model's
+    readings noise."""
     rng = np.random.default_rng(seed)
     recs = []
     for i in range(n):
@@ -77,7 +79,8 @@ def made_up(n: int = 30, seed: int = 0) -> list[dict]:
         recs.append({"id": f"c{i}", "pit": f"p{i // 2}", "status": "ok", "observed": obs,
                      "predicted": "SF" if obs == "SF" and i % 2 else "END", "static_class": "END",
                      "slab_peak_stress_ratio": float(rng.uniform(0.2, 1.2)), "slab_depth": float(rng.uniform(0.2, 0.8)),
-                     "slab_density": float(rng.uniform(100, 250)), "slope_deg": 30.0, "cut_share": 0.4, "wall_s": 1.0})
+                     "slab_density": float(rng.uniform(100, 250)), "slope_deg": 30.0, "cut_share": 0.4, "wall_s": 1.0,
+                     **{k: float(rng.uniform(0.0, 1.0)) for k in MODEL_READINGS}})
     return recs
 
 

@@ -112,24 +112,35 @@ def _forecast(obs: list[str], prob) -> dict:
     return {"auc_sf_vs_end": float(roc_auc_score([obs[i] == "SF" for i in sf_end], prob[sf_end, 1])), **sc}
 
 
+#: the same regression on parts of the readings, and on the records with them: what the dynamic run alone
+#: carries, and whether the model's readings add to the records'
+PARTS = {"run_readings": "the run's readings alone (`run_*`)",
+         "records_and_readings": "the records' four numbers and the model's readings together"}
+
+
 def forecasts(rows: list[dict], described: list[dict], forecast_path: str) -> tuple[dict, dict, dict]:
     """The information bar (the records' four numbers) and the model's readings calibrated
     (``mpm_warp.field.calibrated``: the bar's regression and folds on :data:`~mpm_warp.field.calibrated.MODEL_READINGS`)
-    on the same columns, with their scores; the calibration's paired bootstrap intervals against the bar, the
-    climatology and the forecasts ``forecast_path`` (``field_forecast.json``) gives every one of these columns (the
-    raw model, weac's rule, the majority class)."""
+    on the same columns, with their scores, and the same regression on :data:`PARTS`; the calibration's paired
+    bootstrap intervals against the bar, the climatology and the forecasts ``forecast_path`` (``field_forecast.json``)
+    gives every one of these columns (the raw model, weac's rule, the majority class); the records and readings
+    together against the bar."""
     import numpy as np
 
     from mpm_warp.field.calibrated import MODEL_READINGS, calibrated_forecast, reading_row
     from mpm_warp.field.forecast import climatology
     from mpm_warp.field.forecast_intervals import forecast_intervals
-    from mpm_warp.field.information_bar import information_bar
+    from mpm_warp.field.information_bar import cross_validated, information_bar
 
     obs = [r["observed"] for r in described]
     pits = [case_key(r)[0] for r in rows]
     feats = [[r["slab_depth_m"], r["slab_density"], r["slope_deg"], r["cut_share"]] for r in rows]
-    probs = {"calibrated": calibrated_forecast([reading_row(r) for r in described], obs, pits),
+    readings = np.array([reading_row(r) for r in described], dtype=float)
+    run = [j for j, k in enumerate(MODEL_READINGS) if k.startswith("run_")]
+    probs = {"calibrated": calibrated_forecast(readings, obs, pits),
              "information_bar": information_bar(feats, obs, pits), "climatology": climatology(obs)}
+    parts = {"run_readings": readings[:, run], "records_and_readings": np.hstack([np.array(feats), readings])}
+    probs.update({k: cross_validated(X, obs, pits, folds=5, repeats=20, seed=0) for k, X in parts.items()})
     if os.path.exists(forecast_path):
         with open(forecast_path) as fh:
             given = {c["id"]: c for c in json.load(fh)["cases"]}
@@ -139,6 +150,9 @@ def forecasts(rows: list[dict], described: list[dict], forecast_path: str) -> tu
     scored = {name: _forecast(obs, p) for name, p in probs.items()}
     calibrated = {"readings": MODEL_READINGS, "forecasts_from": os.path.basename(forecast_path), "scores": scored,
                   "uncertainty": forecast_intervals(obs, probs, reference="calibrated", resamples=4000),
+                  "parts": PARTS, "records_and_readings_vs_bar": forecast_intervals(
+                      obs, {k: probs[k] for k in ("records_and_readings", "information_bar")},
+                      reference="records_and_readings", resamples=4000)["differences"]["information_bar"],
                   "missing_readings": {k: int(sum(not math.isfinite(reading_row(r)[j]) for r in described))
                                        for j, k in enumerate(MODEL_READINGS)}}
     return scored["information_bar"], calibrated, {k: p.tolist() for k, p in probs.items()}

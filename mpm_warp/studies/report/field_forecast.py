@@ -61,7 +61,9 @@ def _missing_note(missing: dict) -> str:
 
 
 #: the calibration's table: the forecasts in order, and what each reads
-CALIBRATED = {"calibrated": "the model's readings, calibrated", "information_bar": "the records' four numbers",
+CALIBRATED = {"calibrated": "the model's readings, calibrated", "run_readings": "the run's readings alone",
+              "records_and_readings": "the records' four numbers and the model's readings",
+              "information_bar": "the records' four numbers",
               "model": "the model's raw probability", "weac_static": "weac's static rule",
               "majority": "the majority class", "climatology": "the set's class shares"}
 
@@ -93,6 +95,13 @@ def _calibrated_lines(cal: dict | None) -> list[str]:
             out.append(f"- calibrated minus `{k}`: RPSS {fx(d['rpss']['value'], 2)}{_iv(d['rpss']['interval'])} "
                        f"(better in {fx(d['rpss']['share_better'], 2)} of the draws), balanced accuracy "
                        f"{fx(d['balanced_accuracy']['value'], 2)}{_iv(d['balanced_accuracy']['interval'])}.")
+    both = cal.get("records_and_readings_vs_bar")
+    if both:
+        out.append("- the records and the model's readings together, minus the bar: RPSS "
+                   f"{fx(both['rpss']['value'], 2)}{_iv(both['rpss']['interval'])} (better in "
+                   f"{fx(both['rpss']['share_better'], 2)} of the draws), "
+                   f"balanced accuracy {fx(both['balanced_accuracy']['value'], 2)}"
+                   f"{_iv(both['balanced_accuracy']['interval'])}: what the model's readings add to the records'.")
     c, bar, weac = sc["calibrated"], sc["information_bar"], sc.get("weac_static", {}).get("rpss")
     out += ["", check_line("the model's readings, calibrated, have skill",
                            "RPSS above the climatology's (0) and above weac's rule's",
