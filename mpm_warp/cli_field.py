@@ -32,7 +32,7 @@ def cmd_field(a) -> int:
                     protocol=FieldProtocol(max_particles=a.max_particles, threads=a.threads,
                                            rigid_base=not a.elastic_substratum, pre_cut_share=a.pre_cut_share,
                                            interface_closure=a.interface_closure, columns=columns),
-                    progress=not a.quiet, verbose=a.verbose)
+                    progress=not a.quiet, verbose=a.verbose, calibration=a.calibration)
     sc = res.scores
     for r in res.refused:
         print(f"refused {r.line()}", file=sys.stderr)
@@ -76,6 +76,9 @@ def add_field(sub) -> None:
                    help="start each column sawn this share of weac's critical cut, in [0, 0.9] (default 0.5; 0: none)")
     p.add_argument("--interface-closure", action="store_true",
                    help="run each column with the laminate closure at its layer interfaces (docs/model.md §5b)")
+    p.add_argument("--calibration", metavar="FILE",
+                   help="calibration.json of another batch under the same protocol: its calibrated forecast of the "
+                        "model's readings is scored on these cases too (each batch writes its own)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.add_argument("--verbose", action="store_true", help="Dask's logs on the terminal (default: dask.log in --out)")
     p.set_defaults(func=cmd_field)

@@ -8,6 +8,7 @@ import os
 import pytest
 
 from mpm_warp.cli import main
+from mpm_warp.errors import InvalidArgument
 from mpm_warp.field.batch import finished_records, gather, run_field, score_records
 from mpm_warp.field.probability import weibull_break_probability
 from mpm_warp.field.protocol import FieldProtocol
@@ -104,6 +105,23 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     with open(os.path.join(out, "refused.csv")) as fh:
         assert "slope_deg is empty" in fh.read()
     assert os.path.getsize(os.path.join(out, "confusion.png")) > 0
+    # the batch's calibration of the model's readings, fitted on its two cases (END, ARR), applied by a batch under
+    # the same protocol (here the same folder again, every case resumed); another protocol's batch refuses it
+    from mpm_warp.field.calibration_file import apply_calibration, read_calibration
+
+    cal_path = os.path.join(out, "calibration.json")
+    cal = read_calibration(cal_path, FieldProtocol(threads=2).run_key())
+    assert cal["trained_on"] == {"END": 1, "SF": 0, "ARR": 1}
+    applied = run_field([str(table)], out, workers=1, progress=False, protocol=FieldProtocol(threads=2),
+                        calibration=cal_path)
+    assert applied.skipped == 2
+    assert applied.scores["forecast"]["calibrated_from_file"]["rps"] == pytest.approx(
+        score_records(again.records, calibration=cal)["forecast"]["calibrated_from_file"]["rps"])
+    assert apply_calibration(cal, again.records).shape == (2, 3)
+    with pytest.raises(InvalidArgument, match="max_particles differ"):
+        run_field([str(table)], str(tmp_path / "other"), workers=1, progress=False, calibration=cal_path,
+                  protocol=FieldProtocol(max_particles=20_000))
+    assert not os.path.exists(tmp_path / "other")                    # refused before the batch made its folder
     # a finished case run on past its call, on a copy: the batch's files stay as they were
     from mpm_warp.field.run_on import run_on
 
@@ -144,6 +162,14 @@ def test_a_killed_batch_resumes_without_rerunning_its_finished_cases(tmp_path):
     (back,) = [r for r in finished_records(cases, out) if r["id"] == case["id"]]
     assert {k: back[k] for k in MODEL_READINGS} == {k: case[k] for k in MODEL_READINGS}
     assert body_stress_ratio(out, case["id"], sc, tie_cells=100.0) is None       # 15 cm of slab: no body
+    # a damaged checkpoint: the run's readings are None and the record says where, the case still counts
+    ck = os.path.join(out, case["id"] + ".ckpt.h5")
+    with open(ck, "r+b") as fh:
+        fh.truncate(100)
+    (hurt,) = [r for r in finished_records(cases, out) if r["id"] == case["id"]]
+    assert hurt["status"] == "ok" and all(hurt[k] is None for k in ("run_slab_crack_ratio", *RUN_READINGS))
+    assert hurt["touchdown_distance"] == case["touchdown_distance"]           # the closed forms need no file
+    assert case["id"] + ".ckpt.h5" in hurt["readings_note"] and out in hurt["readings_note"]
 
 
 def test_bad_batch_arguments_are_one_line(tmp_path, capsys):

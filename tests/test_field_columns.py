@@ -21,7 +21,7 @@ tiny-c,End,0,40,12,15,180,5,,0.3,
 def _records(out: str) -> dict:
     recs = {}
     for name in sorted(os.listdir(out)):
-        if name.endswith(".json") and name != "scores.json":
+        if name.endswith(".json") and name not in ("scores.json", "calibration.json"):
             with open(os.path.join(out, name)) as fh:
                 r = json.load(fh)
             recs[r["pit"]] = r

@@ -21,7 +21,6 @@ back is not run again. A case that raises is recorded as failed with its error a
 from __future__ import annotations
 
 import contextlib
-import csv
 import glob
 import hashlib
 import itertools
@@ -35,11 +34,12 @@ from dataclasses import dataclass
 from .. import io
 from ..errors import InvalidArgument
 from ..scenes.pst.params import CRACK_BAND_CELLS
+from .batch_outputs import given_calibration, write_results
 from .batch_setup import Progress, check_out_dir, check_scheduler, dask_client, dask_log, iter_gather
-from .calibrated import CLOSED_FORMS, MODEL_READINGS, add_model_readings, closed_form_readings
+from .calibrated import CLOSED_FORMS, add_model_readings, closed_form_readings
 from .case_run import column_step, run_case, run_case_group, write_case_record
 from .cases import FieldCase, FieldRefusal
-from .information_bar import CASE_FEATURES, case_record_features
+from .information_bar import case_record_features
 from .plain_words import in_field_terms
 from .protocol import FieldProtocol, protocol_equivalent, protocol_params
 from .scores import field_class
@@ -133,8 +133,6 @@ def finished_records(cases: list, out_dir: str, protocol: FieldProtocol | None =
     (default :class:`~.protocol.FieldProtocol`) have finished: what a batch stopped early has measured, scored
     without running or building anything; each with the model's readings (:func:`~.calibrated.add_model_readings`)
     from its files and its case. The cases without a finished run go to ``missing`` where it is given."""
-    from .run_on import scenario_of
-
     proto, claimed, out = protocol or FieldProtocol(), set(), []
     for k, c in enumerate(cases):
         rec = _finished({"out_dir": out_dir, "id": _case_id(c, k, proto)}, claimed)
@@ -142,7 +140,7 @@ def finished_records(cases: list, out_dir: str, protocol: FieldProtocol | None =
             if missing is not None:
                 missing.append(c)
             continue
-        add_model_readings(rec, out_dir, scenario_of(out_dir, rec["id"]), c.params)
+        add_model_readings(rec, out_dir, params=c.params)
         out.append(rec)
     return out
 
@@ -260,7 +258,7 @@ def column_groups(tasks, columns: int, window: int = 4):
 
 def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
               device: str | None = "cpu", protocol: FieldProtocol | None = None, limit: int | None = None,
-              progress=True, verbose: bool = False) -> FieldBatch:
+              progress=True, verbose: bool = False, calibration: str | None = None) -> FieldBatch:
     """Set up, run and score every PST record of ``inputs`` (module docstring).
 
     Parameters
@@ -285,9 +283,13 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
         One progress line on stderr (True), on the given stream, or none.
     verbose : bool
         Dask's logs on the terminal; else in ``dask.log`` in ``out_dir``.
+    calibration : str, optional
+        A ``calibration.json`` another batch under the same protocol wrote: its calibrated forecast is scored on
+        these cases too (:mod:`.calibration_file`; read before anything runs).
     """
     if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
         raise InvalidArgument("limit", limit, "an integer >= 1")
+    cal = given_calibration(calibration, protocol)
     proto = _checked(workers, scheduler, protocol, out_dir, device)
     items, refused, shown = iter_gather(inputs), [], Progress(_stream(progress))
 
@@ -308,7 +310,7 @@ def run_field(inputs, out_dir: str, *, workers: int | None = None, scheduler: st
             shown.refused = len(refused)
             shown.show()
 
-    return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose)
+    return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose, cal)
 
 
 def _checked(workers, scheduler, protocol, out_dir, device=None) -> FieldProtocol:
@@ -333,9 +335,10 @@ def _stream(progress):
 
 def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
               device: str | None = "cpu", protocol: FieldProtocol | None = None, progress=True,
-              verbose: bool = False) -> FieldBatch:
+              verbose: bool = False, calibration: str | None = None) -> FieldBatch:
     """Run the field cases ``cases`` (:func:`gather`'s, or a selection of them) and score them, as :func:`run_field`;
     ``refused`` (their refusals) goes to ``refused.csv``."""
+    cal = given_calibration(calibration, protocol)
     proto = _checked(workers, scheduler, protocol, out_dir, device)
     refused, shown = list(refused), Progress(_stream(progress))
 
@@ -346,10 +349,11 @@ def run_cases(cases: list, refused: list, out_dir: str, *, workers: int | None =
             if task is not None:
                 yield task
 
-    return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose)
+    return _run_tasks(setup(), refused, out_dir, proto, workers, scheduler, shown, verbose, cal)
 
 
-def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Progress, verbose) -> FieldBatch:
+def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Progress, verbose,
+               calibration=None) -> FieldBatch:
     """Run the tasks of the iterator ``tasks`` not finished in ``out_dir`` before, as they are set up; write the
     records, the refusals and the scores."""
     done, ran, records, claimed = [], [], {}, set()
@@ -373,28 +377,5 @@ def _run_tasks(tasks, refused, out_dir, proto, workers, scheduler, progress: Pro
     progress.refused = len(refused)
     progress.end()
     recs = [records[t["id"]] for t in done]
-    _write_outputs(out_dir, recs, refused)
-    sc = score_records(recs)
-    _write_json(os.path.join(out_dir, "scores.json"), sc)
-    from .figures import plot_confusion
-
-    plot_confusion(sc, os.path.join(out_dir, "confusion.png"))
+    sc = write_results(out_dir, recs, refused, proto, calibration)
     return FieldBatch(recs, refused, sc, len(done) - len(ran), out_dir)
-
-
-#: the columns of cases.csv
-CASE_COLUMNS = ("id", "status", "pit", "test", "observed", "predicted", "p_end", "p_sf", "p_arr", "static_class",
-                "static_peak_ratio", "recorded_cut", "runaway_cut", "slab_fracture_at", "slab_peak_stress_ratio",
-                "slab_peak_body_stress_ratio", *CASE_FEATURES, *(k for k in MODEL_READINGS if k != "static_peak_ratio"),
-                "w_f", "w_f_source", "setup", "particles", "steps", "threads", "workers", "wall_s", "run_file", "error")
-
-
-def _write_outputs(out_dir: str, recs: list, refused: list) -> None:
-    with open(os.path.join(out_dir, "cases.csv"), "w", newline="", encoding="utf-8") as fh:
-        w = csv.DictWriter(fh, CASE_COLUMNS, extrasaction="ignore")
-        w.writeheader()
-        w.writerows(recs)
-    with open(os.path.join(out_dir, "refused.csv"), "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(["pit", "test", "outcome", "reason", "message"])
-        w.writerows([r.pit, r.test, r.outcome or "", r.reason, r.message] for r in refused)

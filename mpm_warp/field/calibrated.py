@@ -64,14 +64,25 @@ def run_readings(run_dir: str, case_id: str, scenario) -> dict:
             **{key: got[src] for key, src in RUN_READINGS.items()}}
 
 
-def add_model_readings(rec: dict, run_dir: str, scenario, params=None) -> None:
+def add_model_readings(rec: dict, run_dir: str, scenario=None, params=None) -> None:
     """Give a finished field record ``rec`` what it lacks of :data:`MODEL_READINGS`: the run's from its files in
-    ``run_dir`` (``scenario``: its scenario), the closed forms from ``params`` (the column as recorded; None:
-    left as they are). Nothing is written: a record from before the readings gets them where it is scored."""
+    ``run_dir`` (``scenario``: its scenario; None: the one its final checkpoint stores), the closed forms from
+    ``params`` (the column as recorded; None: left as they are). Nothing is written: a record from before the
+    readings gets them where it is scored. A run file or checkpoint that does not read back leaves the run's
+    readings None and says why in ``readings_note`` (the case still counts; its missing readings take the training
+    folds' medians)."""
     if rec.get("status") != "ok":
         return
     if any(k not in rec for k in ("run_slab_crack_ratio", *RUN_READINGS)):
-        rec.update(run_readings(run_dir, rec["id"], scenario))
+        from .run_on import scenario_of
+
+        try:
+            got = run_readings(run_dir, rec["id"], scenario or scenario_of(run_dir, rec["id"]))
+        except (OSError, KeyError, ValueError) as e:        # a damaged file: h5py's OSError, a missing dataset
+            got = dict.fromkeys(("run_slab_crack_ratio", *RUN_READINGS))
+            rec["readings_note"] = (f"the run's readings could not be read from {rec['id']}.h5 or .ckpt.h5 in "
+                                    f"{run_dir}: {type(e).__name__}: {e}")
+        rec.update(got)
     if params is not None and any(k not in rec for k in CLOSED_FORMS):
         rec.update(closed_form_readings(params))
 

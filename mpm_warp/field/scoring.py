@@ -18,6 +18,7 @@ import statistics
 import numpy as np
 
 from .calibrated import MODEL_READINGS, calibrated_forecast, reading_row
+from .calibration_file import apply_calibration
 from .forecast import climatology, forecast_scores, one_hot
 from .forecast_intervals import forecast_intervals
 from .information_bar import case_features, fold_count, information_bar
@@ -51,9 +52,10 @@ def model_forecast(recs: list) -> np.ndarray | None:
     return np.array(rows, dtype=float).reshape(len(recs), 3)
 
 
-def forecasts(recs: list, *, info_repeats: int = 20) -> tuple[dict, dict]:
+def forecasts(recs: list, *, info_repeats: int = 20, calibration: dict | None = None) -> tuple[dict, dict]:
     """Every forecast that can be made on the scored ``recs`` (name -> (n, 3)) and why any other cannot
-    (name -> one line)."""
+    (name -> one line); ``calibration``: one trained on another batch (:mod:`.calibration_file`), applied to
+    these cases as ``calibrated_from_file``."""
     obs = [r["observed"] for r in recs]
     out, why = {}, {}
     model = model_forecast(recs)
@@ -85,10 +87,13 @@ def forecasts(recs: list, *, info_repeats: int = 20) -> tuple[dict, dict]:
         why["calibrated"] = "too few cases to cross-validate: it needs 2 pits and 2 cases of one class at least"
     else:
         out["calibrated"] = calibrated_forecast(readings, obs, pits, folds=FOLDS, repeats=info_repeats)
+    if calibration is not None:
+        out["calibrated_from_file"] = apply_calibration(calibration, recs)
     return out, why
 
 
-def score_records(recs: list, *, resamples: int = 2000, probs: tuple[dict, dict] | None = None) -> dict:
+def score_records(recs: list, *, resamples: int = 2000, probs: tuple[dict, dict] | None = None,
+                  calibration: dict | None = None) -> dict:
     """Scores of the model and of the references on the scored records (module docstring).
 
     Returns
@@ -98,13 +103,13 @@ def score_records(recs: list, *, resamples: int = 2000, probs: tuple[dict, dict]
         :func:`~.scores.scores`; ``uncertainty`` (balanced accuracies); ``forecast`` {name: :func:`~.forecast.
         forecast_scores`}, ``forecast_missing`` {name: why}, ``forecast_uncertainty`` (paired intervals against the
         model, when it has a forecast); the wall times. ``probs``: :func:`forecasts` of the scored records, when
-        the caller has it already.
+        the caller has it already. ``calibration``: as :func:`forecasts`.
     """
     ok = scored(recs)
     obs = [r["observed"] for r in ok]
     pred = {"model": [r["predicted"] for r in ok], "majority": baseline_majority(obs),
             "weac_static": [r.get("static_class") or "none" for r in ok]}
-    probs, missing = probs or (forecasts(ok) if ok else ({}, {"model": "no case was scored"}))
+    probs, missing = probs or (forecasts(ok, calibration=calibration) if ok else ({}, {"model": "no case was scored"}))
     out = {"cases": len(ok), "failed": sum(r.get("status") != "ok" for r in recs),
            **{name: scores(obs, p) for name, p in pred.items()},
            "uncertainty": balanced_accuracy_intervals(obs, pred, reference="model"),
