@@ -115,6 +115,7 @@ def _forecast(obs: list[str], prob) -> dict:
 #: the same regression on parts of the readings, and on the records with them: what the dynamic run alone
 #: carries, and whether the model's readings add to the records'
 PARTS = {"run_readings": "the run's readings alone (`run_*`)",
+         "static_readings": "weac's and the closed forms' readings alone (all but `run_*`)",
          "records_and_readings": "the records' four numbers and the model's readings together"}
 
 
@@ -139,7 +140,9 @@ def forecasts(rows: list[dict], described: list[dict], forecast_path: str) -> tu
     run = [j for j, k in enumerate(MODEL_READINGS) if k.startswith("run_")]
     probs = {"calibrated": calibrated_forecast(readings, obs, pits),
              "information_bar": information_bar(feats, obs, pits), "climatology": climatology(obs)}
-    parts = {"run_readings": readings[:, run], "records_and_readings": np.hstack([np.array(feats), readings])}
+    static = [j for j in range(len(MODEL_READINGS)) if j not in run]
+    parts = {"run_readings": readings[:, run], "static_readings": readings[:, static],
+             "records_and_readings": np.hstack([np.array(feats), readings])}
     probs.update({k: cross_validated(X, obs, pits, folds=5, repeats=20, seed=0) for k, X in parts.items()})
     if os.path.exists(forecast_path):
         with open(forecast_path) as fh:

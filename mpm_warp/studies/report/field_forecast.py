@@ -62,6 +62,7 @@ def _missing_note(missing: dict) -> str:
 
 #: the calibration's table: the forecasts in order, and what each reads
 CALIBRATED = {"calibrated": "the model's readings, calibrated", "run_readings": "the run's readings alone",
+              "static_readings": "weac's and the closed forms' readings alone",
               "records_and_readings": "the records' four numbers and the model's readings",
               "information_bar": "the records' four numbers",
               "model": "the model's raw probability", "weac_static": "weac's static rule",
