@@ -151,11 +151,33 @@ def _outcomes(ctx: Context) -> str | None:
             f"({_link('Field outcomes against the observers')})).")
 
 
+def _forecast(ctx: Context) -> str | None:
+    """The field outcomes as probabilities: the model's skill, its readings' calibrated, and the bar's."""
+    data = ctx.load("field/results/field_forecast.json")
+    if data is None:
+        return None
+    f = data["scores"]["forecast"]
+    iv = (data["scores"].get("forecast_uncertainty") or {}).get("intervals") or {}
+    if not {"model", "calibrated", "information_bar"} <= set(f):
+        return None
+
+    def skill(key: str) -> str:
+        b = iv.get(key, {}).get("rpss")
+        return f"{f[key]['rpss']:.2f}" + (f" [{b[0]:.2f}, {b[1]:.2f}]" if b else "")
+
+    return (f"- **As a probability:** on the same PSTs the model's ranked probability skill against the set's own "
+            f"class shares is {skill('model')}; its readings calibrated as a forecaster calibrates a model, "
+            f"cross-validated by pit, score {skill('calibrated')}, beside {skill('information_bar')} for the same "
+            f"regression on the records' own numbers ([The outcome as a probability: forecast scores]"
+            f"({_link('The outcome as a probability: forecast scores')})).")
+
+
 def headlines(ctx: Context) -> list[str]:
     """The README's headline bullets (a bullet whose results are not committed is left out)."""
     out = [_throughput(ctx, "perf/results/throughput_cpu.json", 3, "Throughput beside Taichi, 3D"),
            _throughput(ctx, "perf/results/throughput_2d_cpu.json", 2, "Throughput beside Taichi, 2D"),
-           _pst_speed(ctx), _critical_cut(ctx), _slope(ctx), _shear(ctx), _field(ctx), _outcomes(ctx)]
+           _pst_speed(ctx), _critical_cut(ctx), _slope(ctx), _shear(ctx), _field(ctx), _outcomes(ctx),
+           _forecast(ctx)]
     return [b for b in out if b]
 
 
