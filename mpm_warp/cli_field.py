@@ -41,9 +41,16 @@ def cmd_field(a) -> int:
         v = sc[k]["balanced_accuracy"]
         return "-" if v is None else f"{v:.3f}"
 
+    def skill(k):
+        v = sc.get("forecast", {}).get(k, {}).get("rpss")
+        return "-" if v is None else f"{v:+.3f}"
+
     print(f"field: {sc['cases']} cases scored ({res.skipped} from an earlier batch), {sc['failed']} failed, "
           f"{len(res.refused)} records refused (refused.csv)\nbalanced accuracy: model {ba('model')}, majority "
-          f"class {ba('majority')}, weac static {ba('weac_static')}\nresults: {res.out_dir}")
+          f"class {ba('majority')}, weac static {ba('weac_static')}\nranked probability skill against the cases' "
+          f"climatology: model {skill('model')}, its readings calibrated {skill('calibrated')}, information bar "
+          f"{skill('information_bar')}" + (f", calibration file {skill('calibrated_from_file')}" if a.calibration
+                                           else "") + f" (scores.json)\nresults: {res.out_dir}")
     for r in res.records:
         if r.get("status") != "ok":
             print(f"failed {r['id']}: {r.get('error')}", file=sys.stderr)

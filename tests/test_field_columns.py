@@ -52,7 +52,15 @@ def test_cases_stepped_together_keep_their_class_and_say_what_the_shared_step_co
     assert t["psts.csv#tiny-c"]["steps"] > a["psts.csv#tiny-c"]["steps"]
     # a rerun finds every case of the group finished and runs none
     assert main(["field", str(table), "--out", together, "--workers", "1", "--columns", "3", "--quiet"]) == 0
-    assert "(3 from an earlier batch)" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "(3 from an earlier batch)" in out and "ranked probability skill against the cases' climatology" in out
+    # the lone batch's calibration (END and ARR) applied to the grouped one: how many columns step together aside,
+    # the protocols are the same
+    cal = os.path.join(alone, "calibration.json")
+    assert main(["field", str(table), "--out", together, "--workers", "1", "--columns", "3", "--quiet",
+                 "--calibration", cal]) == 0
+    out = capsys.readouterr().out
+    assert "calibration file " in out and "calibration file -" not in out
 
 
 def test_groups_of_columns_come_sorted_by_their_own_step_within_a_window(monkeypatch):
