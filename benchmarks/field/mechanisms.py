@@ -17,7 +17,6 @@ Usage: ``python benchmarks/field/mechanisms.py --data DIR`` (DIR: the unpacked p
 from __future__ import annotations
 
 import json
-import math
 import os
 import statistics
 import sys
@@ -156,8 +155,8 @@ def forecasts(rows: list[dict], described: list[dict], forecast_path: str) -> tu
                   "parts": PARTS, "records_and_readings_vs_bar": forecast_intervals(
                       obs, {k: probs[k] for k in ("records_and_readings", "information_bar")},
                       reference="records_and_readings", resamples=4000)["differences"]["information_bar"],
-                  "missing_readings": {k: int(sum(not math.isfinite(reading_row(r)[j]) for r in described))
-                                       for j, k in enumerate(MODEL_READINGS)}}
+                  "missing_readings": dict(zip(MODEL_READINGS, map(int, np.isnan(readings).sum(axis=0)),
+                                               strict=True))}
     return scored["information_bar"], calibrated, {k: p.tolist() for k, p in probs.items()}
 
 
